@@ -1,0 +1,60 @@
+//! `slosh bench`: particle-steps per second and real-time factor on the project's benchmark cases.
+
+use crate::config;
+use serde::Serialize;
+use sph::motion::TankMotion;
+use std::time::Instant;
+
+/// A benchmark case: a built-in config with overrides and a default simulated time.
+pub struct Case {
+    pub name: &'static str,
+    pub builtin: &'static str,
+    pub overrides: &'static [&'static str],
+    pub duration: f64,
+}
+
+pub const CASES: &[Case] = &[
+    Case { name: "dambreak_2d", builtin: "dambreak_2d", overrides: &[], duration: 0.6 },
+    Case { name: "seed_2d_dp8mm", builtin: "seed_tank_039", overrides: &["dimension=2", "particle_spacing=0.008"], duration: 2.0 },
+    Case { name: "seed_3d_dp20mm", builtin: "seed_tank_039", overrides: &["dimension=3", "particle_spacing=0.02"], duration: 1.0 },
+];
+
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchResult {
+    pub case: String,
+    pub threads: usize,
+    pub particles_fluid: usize,
+    pub particles_boundary: usize,
+    pub steps: u64,
+    pub sim_time_s: f64,
+    pub wall_time_s: f64,
+    pub particle_steps_per_s: f64,
+    pub realtime_factor: f64,
+    pub wall_s_per_sim_s: f64,
+}
+
+/// Runs one case for `duration` simulated seconds (setup excluded from the timing).
+pub fn run_case(case: &Case, duration: Option<f64>) -> anyhow::Result<BenchResult> {
+    let overrides: Vec<String> = case.overrides.iter().map(|s| s.to_string()).collect();
+    let cfg = config::load(case.builtin, &overrides)?;
+    let params = cfg.sim_params()?;
+    let motion: Box<dyn TankMotion> = crate::motion_source::build(&cfg)?;
+    let mut sim = sph::build(params)?;
+    let duration = duration.unwrap_or(case.duration);
+    let start = Instant::now();
+    sim.advance_to(motion.as_ref(), duration)?;
+    let wall = start.elapsed().as_secs_f64();
+    let (stats, counts) = (sim.stats(), sim.counts());
+    Ok(BenchResult {
+        case: case.name.to_string(),
+        threads: rayon::current_num_threads(),
+        particles_fluid: counts.fluid,
+        particles_boundary: counts.boundary,
+        steps: stats.steps,
+        sim_time_s: sim.time(),
+        wall_time_s: wall,
+        particle_steps_per_s: stats.steps as f64 * counts.fluid as f64 / wall,
+        realtime_factor: sim.time() / wall,
+        wall_s_per_sim_s: wall / sim.time(),
+    })
+}

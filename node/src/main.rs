@@ -1,0 +1,83 @@
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use slosh_node::{bench, config, runner};
+use std::path::PathBuf;
+
+/// Sloshing of a liquid in a moving tank, by SPH.
+#[derive(Parser)]
+#[command(name = "slosh", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a case headless and write probes.csv, wrench.csv, pressure.csv and summary.json.
+    Run {
+        /// Config file (ROS 2 parameters layout) or the name of a built-in case (seed_tank_039, dambreak_2d, ...).
+        config: String,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Simulated seconds (default: the config's `duration`).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Override a parameter by its dotted name, value as YAML: --set solver.cfl=0.15 --set probes.x=[-0.3,0.0]
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
+    /// Time the benchmark cases: particle-steps per second and real-time factor.
+    Bench {
+        /// Only this case (dambreak_2d, seed_2d_dp8mm, seed_3d_dp20mm); default: all.
+        #[arg(long)]
+        case: Vec<String>,
+        /// Simulated seconds per case (default: each case's own).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Print one JSON object per case instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run { config: cfg, out, duration, set } => {
+            let loaded = config::load(&cfg, &set)?;
+            eprintln!("slosh: running {} for {} s, writing to {}", loaded.source_name, duration.unwrap_or(loaded.config.duration), out.display());
+            let opts = runner::RunOptions { duration, progress: true };
+            let s = runner::run(&loaded, &out, &opts)?;
+            println!(
+                "done: {} s simulated in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s, {} liquid + {} boundary particles, {} lost)",
+                s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s, s.particles_fluid, s.particles_boundary, s.particles_lost
+            );
+            println!("outputs: {}/{{probes.csv, wrench.csv, pressure.csv, summary.json}}", out.display());
+        }
+        Command::Bench { case, duration, json } => {
+            let cases: Vec<&bench::Case> = if case.is_empty() {
+                bench::CASES.iter().collect()
+            } else {
+                case.iter()
+                    .map(|c| bench::CASES.iter().find(|k| k.name == c).with_context(|| format!("unknown case {c}; cases: dambreak_2d, seed_2d_dp8mm, seed_3d_dp20mm")))
+                    .collect::<anyhow::Result<_>>()?
+            };
+            if !json {
+                println!("{:<16} {:>7} {:>9} {:>8} {:>8} {:>10} {:>14} {:>10} {:>12}", "case", "threads", "particles", "steps", "sim s", "wall s", "particle-st/s", "RT factor", "wall s/sim s");
+            }
+            for c in cases {
+                let r = bench::run_case(c, duration)?;
+                if json {
+                    println!("{}", serde_json::to_string(&r)?);
+                } else {
+                    println!(
+                        "{:<16} {:>7} {:>9} {:>8} {:>8.3} {:>10.2} {:>14.3e} {:>10.4} {:>12.1}",
+                        r.case, r.threads, r.particles_fluid, r.steps, r.sim_time_s, r.wall_time_s, r.particle_steps_per_s, r.realtime_factor, r.wall_s_per_sim_s
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,86 @@
+//! Run outputs: `probes.csv`, `wrench.csv`, `pressure.csv` (a row per output time) and `summary.json`.
+//! Rows are flushed as they are written, so a run that fails keeps everything up to the failure.
+
+use sph::observe::Observation;
+use sph::params::SimParams;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+pub struct CsvOutputs {
+    probes: BufWriter<File>,
+    wrench: BufWriter<File>,
+    pressure: BufWriter<File>,
+    dir: PathBuf,
+}
+
+fn create(dir: &Path, name: &str, header: &str) -> std::io::Result<BufWriter<File>> {
+    let path = dir.join(name);
+    let mut w = BufWriter::new(File::create(&path).map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?);
+    writeln!(w, "{header}")?;
+    Ok(w)
+}
+
+impl CsvOutputs {
+    /// Creates the folder and the three CSV files with their headers.
+    pub fn create(dir: &Path, params: &SimParams) -> std::io::Result<Self> {
+        std::fs::create_dir_all(dir).map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
+        let names = |v: Vec<&str>| std::iter::once("time").chain(v).collect::<Vec<_>>().join(",");
+        Ok(Self {
+            probes: create(dir, "probes.csv", &names(params.probes.iter().map(|p| p.name.as_str()).collect()))?,
+            wrench: create(dir, "wrench.csv", "time,fx,fy,fz,mx,my,mz")?,
+            pressure: create(dir, "pressure.csv", &names(params.pressure_sensors.iter().map(|p| p.name.as_str()).collect()))?,
+            dir: dir.to_path_buf(),
+        })
+    }
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Appends one row to each file.
+    pub fn write(&mut self, o: &Observation) -> std::io::Result<()> {
+        let row = |w: &mut BufWriter<File>, vals: &mut dyn Iterator<Item = f64>| -> std::io::Result<()> {
+            write!(w, "{:.6}", o.time)?;
+            for v in vals {
+                write!(w, ",{v:.6e}")?;
+            }
+            writeln!(w)
+        };
+        row(&mut self.probes, &mut o.probes.iter().copied())?;
+        row(&mut self.wrench, &mut o.wrench.force.iter().chain(o.wrench.moment.iter()).copied())?;
+        row(&mut self.pressure, &mut o.pressures.iter().copied())?;
+        Ok(())
+    }
+
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        self.probes.flush()?;
+        self.wrench.flush()?;
+        self.pressure.flush()
+    }
+}
+
+/// Contents of `summary.json`.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Summary {
+    pub dimension: usize,
+    pub particles_fluid: usize,
+    pub particles_boundary: usize,
+    pub particles_lost: usize,
+    pub steps: u64,
+    pub force_evaluations: u64,
+    pub sim_time_s: f64,
+    pub wall_time_s: f64,
+    pub realtime_factor: f64,
+    pub particle_steps_per_s: f64,
+    pub min_dt_s: f64,
+    pub liquid_mass_kg: f64,
+    /// Why the run stopped early, if it did.
+    pub error: Option<String>,
+    pub parameters: serde_json::Value,
+}
+
+pub fn write_summary(dir: &Path, s: &Summary) -> std::io::Result<()> {
+    let text = serde_json::to_string_pretty(s).expect("summary serialises");
+    std::fs::write(dir.join("summary.json"), text + "\n")
+}

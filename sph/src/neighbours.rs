@@ -1,0 +1,278 @@
+//! Cell lists: a fixed grid over the tank (the tank frame does not move, so neither does the grid), particles
+//! kept sorted by cell with a stable counting sort, and the contiguous index ranges that hold a cell's
+//! neighbours. Cells are as wide as the kernel support, x varies fastest, so the 3 cells of a row are one range.
+//! [`naive_pairs`] is the O(N²) reference the tests hold the grid to.
+
+/// Marks a particle outside the grid.
+pub const OUTSIDE: u32 = u32::MAX;
+
+/// At most 3^(D−1) ranges per cell: 3 in 2D, 9 in 3D.
+pub type Ranges = [(u32, u32); 9];
+
+#[derive(Clone, Debug)]
+pub struct Grid<const D: usize> {
+    origin: [f64; D],
+    inv_cell: f64,
+    cell: f64,
+    dims: [usize; D],
+}
+
+impl<const D: usize> Grid<D> {
+    /// Grid covering the box [lo, hi] with cells at least `cell` wide.
+    pub fn new(lo: [f64; D], hi: [f64; D], cell: f64) -> Self {
+        let mut dims = [0; D];
+        for k in 0..D {
+            dims[k] = (((hi[k] - lo[k]) / cell).ceil() as usize).max(1);
+        }
+        Self { origin: lo, inv_cell: 1.0 / cell, cell, dims }
+    }
+
+    pub fn dims(&self) -> [usize; D] {
+        self.dims
+    }
+
+    pub fn cell_size(&self) -> f64 {
+        self.cell
+    }
+
+    pub fn n_cells(&self) -> usize {
+        self.dims.iter().product()
+    }
+
+    /// Lower and upper corner of the grid.
+    pub fn bounds(&self) -> ([f64; D], [f64; D]) {
+        let mut hi = self.origin;
+        for k in 0..D {
+            hi[k] += self.dims[k] as f64 * self.cell;
+        }
+        (self.origin, hi)
+    }
+
+    /// Cell holding `p`, or [`OUTSIDE`] (also for NaN).
+    #[inline]
+    pub fn cell_of(&self, p: [f64; D]) -> u32 {
+        let mut idx = 0usize;
+        let mut stride = 1usize;
+        for k in 0..D {
+            let c = (p[k] - self.origin[k]) * self.inv_cell;
+            // `!(c >= 0)` is true for NaN too.
+            if !(c >= 0.0) || c >= self.dims[k] as f64 {
+                return OUTSIDE;
+            }
+            idx += c as usize * stride;
+            stride *= self.dims[k];
+        }
+        idx as u32
+    }
+
+    /// Integer coordinates of a point's cell, possibly outside the grid.
+    #[inline]
+    fn coords_of(&self, p: [f64; D]) -> [i64; D] {
+        let mut c = [0i64; D];
+        for k in 0..D {
+            c[k] = ((p[k] - self.origin[k]) * self.inv_cell).floor() as i64;
+        }
+        c
+    }
+
+    #[inline]
+    fn coords(&self, cell: u32) -> [i64; D] {
+        let mut c = [0i64; D];
+        let mut rest = cell as usize;
+        for k in 0..D {
+            c[k] = (rest % self.dims[k]) as i64;
+            rest /= self.dims[k];
+        }
+        c
+    }
+
+    /// Index ranges (into the sorted particle arrays described by `starts`) of the cells around the cell at
+    /// integer coordinates `c`. Returns how many of `out` are filled.
+    #[inline]
+    fn ranges_at(&self, c: [i64; D], starts: &[u32], out: &mut Ranges) -> usize {
+        let nx = self.dims[0] as i64;
+        let x0 = (c[0] - 1).max(0);
+        let x1 = (c[0] + 1).min(nx - 1);
+        if x0 > x1 {
+            return 0;
+        }
+        let mut n = 0;
+        // Iterate over the 3^(D-1) rows around c in the higher dimensions.
+        let rows = 3usize.pow(D as u32 - 1);
+        'rows: for r in 0..rows {
+            let mut rest = r;
+            let mut base = 0i64;
+            let mut stride = nx;
+            for k in 1..D {
+                let ck = c[k] + (rest % 3) as i64 - 1;
+                rest /= 3;
+                if ck < 0 || ck >= self.dims[k] as i64 {
+                    continue 'rows;
+                }
+                base += ck * stride;
+                stride *= self.dims[k] as i64;
+            }
+            let a = starts[(base + x0) as usize];
+            let b = starts[(base + x1 + 1) as usize];
+            if b > a {
+                out[n] = (a, b);
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// Neighbour ranges of the particles of `cell`.
+    #[inline]
+    pub fn ranges(&self, cell: u32, starts: &[u32], out: &mut Ranges) -> usize {
+        self.ranges_at(self.coords(cell), starts, out)
+    }
+
+    /// Neighbour ranges of an arbitrary point (probes, sensors); points off the grid see what is in reach.
+    #[inline]
+    pub fn ranges_around(&self, p: [f64; D], starts: &[u32], out: &mut Ranges) -> usize {
+        let c = self.coords_of(p);
+        for k in 0..D {
+            if c[k] < -1 || c[k] > self.dims[k] as i64 {
+                return 0;
+            }
+        }
+        self.ranges_at(c, starts, out)
+    }
+}
+
+/// Stable counting sort by cell. `cells[i]` is particle i's cell or [`OUTSIDE`]. Fills `starts` (n_cells + 1
+/// offsets) and `dest[i]`, the sorted position of particle i; particles outside go after all others, in order.
+/// Returns the number of particles inside the grid.
+pub fn counting_sort(n_cells: usize, cells: &[u32], starts: &mut Vec<u32>, dest: &mut Vec<u32>) -> usize {
+    starts.clear();
+    starts.resize(n_cells + 2, 0);
+    for &c in cells {
+        let slot = if c == OUTSIDE { n_cells } else { c as usize };
+        starts[slot + 1] += 1;
+    }
+    for i in 0..=n_cells {
+        starts[i + 1] += starts[i];
+    }
+    dest.clear();
+    dest.resize(cells.len(), 0);
+    // Running cursor per cell, reusing a second pass over a copy of the offsets.
+    let inside = starts[n_cells] as usize;
+    let mut cursor: Vec<u32> = starts[..=n_cells].to_vec();
+    for (i, &c) in cells.iter().enumerate() {
+        let slot = if c == OUTSIDE { n_cells } else { c as usize };
+        dest[i] = cursor[slot];
+        cursor[slot] += 1;
+    }
+    starts.truncate(n_cells + 1);
+    inside
+}
+
+/// Applies the permutation `dest` (from [`counting_sort`]) to `v`, using `scratch`, keeping the first `keep`.
+pub fn permute<T: Copy + Default>(v: &mut Vec<T>, dest: &[u32], scratch: &mut Vec<T>, keep: usize) {
+    scratch.clear();
+    scratch.resize(v.len(), T::default());
+    for (i, &d) in dest.iter().enumerate() {
+        scratch[d as usize] = v[i];
+    }
+    std::mem::swap(v, scratch);
+    v.truncate(keep);
+}
+
+/// All pairs (i, j), i ≠ j, closer than `radius`, by brute force: the reference for the grid.
+pub fn naive_pairs<const D: usize>(pos: &[[f64; D]], radius: f64) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    for i in 0..pos.len() {
+        for j in 0..pos.len() {
+            if i != j {
+                let r2: f64 = (0..D).map(|k| (pos[i][k] - pos[j][k]).powi(2)).sum();
+                if r2 < radius * radius {
+                    out.push((i, j));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The same pairs found through the grid (positions are sorted internally; returned with original indices).
+pub fn grid_pairs<const D: usize>(grid: &Grid<D>, pos: &[[f64; D]], radius: f64) -> Vec<(usize, usize)> {
+    let cells: Vec<u32> = pos.iter().map(|p| grid.cell_of(*p)).collect();
+    let (mut starts, mut dest) = (Vec::new(), Vec::new());
+    let inside = counting_sort(grid.n_cells(), &cells, &mut starts, &mut dest);
+    let mut order = vec![0usize; pos.len()];
+    for (i, &d) in dest.iter().enumerate() {
+        order[d as usize] = i;
+    }
+    let mut out = Vec::new();
+    let mut ranges = [(0, 0); 9];
+    for (i, p) in pos.iter().enumerate() {
+        if cells[i] == OUTSIDE {
+            continue;
+        }
+        let n = grid.ranges(cells[i], &starts, &mut ranges);
+        for &(a, b) in &ranges[..n] {
+            for s in a..b {
+                let j = order[s as usize];
+                let r2: f64 = (0..D).map(|k| (p[k] - pos[j][k]).powi(2)).sum();
+                if j != i && r2 < radius * radius {
+                    out.push((i, j));
+                }
+            }
+        }
+    }
+    assert!(inside <= pos.len());
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn random_points<const D: usize>(n: usize, seed: u64, lo: f64, hi: f64) -> Vec<[f64; D]> {
+        let mut s = seed;
+        let mut next = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n).map(|_| std::array::from_fn(|_| lo + (hi - lo) * next())).collect()
+    }
+
+    fn check<const D: usize>() {
+        let radius = 0.07;
+        let grid = Grid::<D>::new([0.0; D], [1.0; D], radius);
+        let pos = random_points::<D>(if D == 2 { 2000 } else { 3000 }, 42 + D as u64, 0.0, 0.999);
+        let mut a = naive_pairs(&pos, radius);
+        let mut b = grid_pairs(&grid, &pos, radius);
+        a.sort_unstable();
+        b.sort_unstable();
+        assert!(a.len() > 1000);
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn grid_finds_exactly_the_naive_pairs_2d() {
+        check::<2>();
+    }
+
+    #[test]
+    fn grid_finds_exactly_the_naive_pairs_3d() {
+        check::<3>();
+    }
+
+    #[test]
+    fn points_off_the_grid_and_nan_are_outside() {
+        let g = Grid::<2>::new([0.0, 0.0], [1.0, 1.0], 0.1);
+        assert_eq!(g.cell_of([-0.01, 0.5]), OUTSIDE);
+        assert_eq!(g.cell_of([0.5, 1.01]), OUTSIDE);
+        assert_eq!(g.cell_of([f64::NAN, 0.5]), OUTSIDE);
+        assert_eq!(g.cell_of([0.05, 0.15]), 10);
+        let cells = vec![3, OUTSIDE, 1, 3];
+        let (mut s, mut d) = (Vec::new(), Vec::new());
+        assert_eq!(counting_sort(g.n_cells(), &cells, &mut s, &mut d), 3);
+        assert_eq!(d, vec![1, 3, 0, 2]);
+        let mut v = vec![10, 11, 12, 13];
+        permute(&mut v, &d, &mut Vec::new(), 3);
+        assert_eq!(v, vec![12, 10, 13]);
+    }
+}

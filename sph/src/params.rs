@@ -1,0 +1,351 @@
+//! The typed description of a case: tank, liquid, resolution, solver choices and observation points.
+//! Plain data with defaults; [`SimParams::validate`] names the offending field of anything unusable.
+
+use crate::kernel::KernelKind;
+use serde::{Deserialize, Serialize};
+
+/// A closed rectangular tank. Tank frame: origin at the centre of the tank bottom, x along `length`,
+/// y along `breadth`, z up. A 2D run simulates the x–z plane and scales forces by `breadth`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TankSpec {
+    /// m, along x.
+    pub length: f64,
+    /// m, along y (the thickness a 2D result stands for).
+    pub breadth: f64,
+    /// m, along z.
+    pub height: f64,
+}
+
+/// Liquid properties.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FluidSpec {
+    /// Reference density ρ0, kg/m³.
+    pub density: f64,
+    /// Kinematic viscosity ν, m²/s (used when `solver.laminar_viscosity` is on).
+    pub kinematic_viscosity: f64,
+}
+
+impl Default for FluidSpec {
+    fn default() -> Self {
+        Self { density: 1000.0, kinematic_viscosity: 1.0e-6 }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Scheme {
+    /// Weakly-compressible SPH (the paper's scheme).
+    Wcsph,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integrator {
+    /// Two-stage symplectic predictor–corrector (position-Verlet style, two force evaluations a step).
+    Symplectic,
+    /// Leap-frog Verlet with one force evaluation a step and an Euler step every `verlet_reset_steps`
+    /// (as in DualSPHysics).
+    Verlet,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DiffusionKind {
+    None,
+    /// Molteni & Colagrossi (2009).
+    MolteniColagrossi,
+    /// Fourtakas et al. (2019): diffuses only the dynamic (non-hydrostatic) part of the density.
+    Fourtakas,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BoundaryMethod {
+    /// Layers of boundary particles fixed to the tank, density from continuity, pressure from the EOS
+    /// (the paper's quasi-ghost particles; Crespo et al. 2007 "dynamic boundary condition").
+    Dynamic,
+    /// Mirror ("dynamic ghost") particles of the fluid near each wall, with opposite normal velocity and the
+    /// paper's anti-penetration restraint.
+    Mirror,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ArtificialViscosity {
+    /// Linear coefficient α of Monaghan's artificial viscosity.
+    pub alpha: f64,
+    /// Quadratic coefficient β.
+    pub beta: f64,
+    /// η² = eta_factor · h² regularises 1/r² (the paper: 0.01).
+    pub eta_factor: f64,
+}
+
+impl Default for ArtificialViscosity {
+    fn default() -> Self {
+        Self { alpha: 0.02, beta: 0.0, eta_factor: 0.01 }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DensityDiffusion {
+    pub kind: DiffusionKind,
+    /// δ coefficient (0.1 is usual).
+    pub delta: f64,
+}
+
+impl Default for DensityDiffusion {
+    fn default() -> Self {
+        Self { kind: DiffusionKind::Fourtakas, delta: 0.1 }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BoundarySpec {
+    pub method: BoundaryMethod,
+    /// Number of boundary particle layers of the tank walls (dynamic method); 0 = enough to cover the kernel
+    /// support, ceil(2h/dp).
+    pub layers: u32,
+}
+
+impl Default for BoundarySpec {
+    fn default() -> Self {
+        Self { method: BoundaryMethod::Dynamic, layers: 0 }
+    }
+}
+
+/// Solver choices. Defaults follow the paper where it gives a value, DualSPHysics' practice elsewhere.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSpec {
+    pub scheme: Scheme,
+    pub kernel: KernelKind,
+    /// h / particle spacing.
+    pub smoothing_ratio: f64,
+    pub integrator: Integrator,
+    /// Courant number of the CFL condition.
+    pub cfl: f64,
+    /// c0 = coefficient · sqrt(g · H). The paper's bound κ = 200 g H ρ / γ is a coefficient of √200 ≈ 14.14.
+    pub sound_speed_coefficient: f64,
+    /// H in the sound speed, m; 0 = the liquid's initial height.
+    pub reference_height: f64,
+    /// Explicit c0 in m/s; 0 = from the coefficient.
+    pub sound_speed: f64,
+    pub artificial_viscosity: ArtificialViscosity,
+    /// Adds the laminar viscous term of Lo & Shao (2002) with `fluid.kinematic_viscosity`.
+    pub laminar_viscosity: bool,
+    pub density_diffusion: DensityDiffusion,
+    pub boundary: BoundarySpec,
+    /// The run fails when the CFL time step falls below this, s; 0 = 1e-4 of the initial estimate.
+    pub dt_min: f64,
+    /// Largest time step, s (also bounded by the output interval).
+    pub dt_max: f64,
+    /// Verlet integrator: every n-th step is an Euler step.
+    pub verlet_reset_steps: u32,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        Self {
+            scheme: Scheme::Wcsph,
+            kernel: KernelKind::CubicSpline,
+            smoothing_ratio: 1.3,
+            integrator: Integrator::Symplectic,
+            cfl: 0.2,
+            sound_speed_coefficient: 200f64.sqrt(),
+            reference_height: 0.0,
+            sound_speed: 0.0,
+            artificial_viscosity: ArtificialViscosity::default(),
+            laminar_viscosity: false,
+            density_diffusion: DensityDiffusion::default(),
+            boundary: BoundarySpec::default(),
+            dt_min: 0.0,
+            dt_max: 1.0e-3,
+            verlet_reset_steps: 40,
+        }
+    }
+}
+
+/// A wave probe: a vertical line at (x, y) in the tank frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ProbeSpec {
+    pub name: String,
+    pub x: f64,
+    pub y: f64,
+}
+
+/// A pressure sensor at a point in the tank frame (on a wall face or slightly inside the liquid).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SensorSpec {
+    pub name: String,
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+}
+
+/// The liquid's initial shape: a block against the tank's −x wall, `length` long (0 = the whole tank) and
+/// `height` deep, at rest with hydrostatic pressure.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FillSpec {
+    pub height: f64,
+    pub length: f64,
+}
+
+/// Everything needed to build a simulation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SimParams {
+    /// 2 or 3.
+    pub dimension: usize,
+    pub tank: TankSpec,
+    pub fill: FillSpec,
+    /// Particle spacing dp, m.
+    pub particle_spacing: f64,
+    pub fluid: FluidSpec,
+    /// m/s².
+    pub gravity: f64,
+    pub solver: SolverSpec,
+    pub probes: Vec<ProbeSpec>,
+    pub pressure_sensors: Vec<SensorSpec>,
+}
+
+/// A parameter that cannot be used, with the field's dotted name and what would be accepted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field}: {message}")]
+pub struct ParamError {
+    pub field: String,
+    pub message: String,
+}
+
+fn err(field: &str, message: impl Into<String>) -> ParamError {
+    ParamError { field: field.to_string(), message: message.into() }
+}
+
+fn positive(field: &str, v: f64) -> Result<(), ParamError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(err(field, format!("must be a positive number, got {v}")))
+    }
+}
+
+fn non_negative(field: &str, v: f64) -> Result<(), ParamError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(err(field, format!("must be zero or positive, got {v}")))
+    }
+}
+
+impl SimParams {
+    /// The liquid block's length along x.
+    pub fn fill_length(&self) -> f64 {
+        if self.fill.length > 0.0 {
+            self.fill.length
+        } else {
+            self.tank.length
+        }
+    }
+
+    /// Smoothing length h.
+    pub fn h(&self) -> f64 {
+        self.solver.smoothing_ratio * self.particle_spacing
+    }
+
+    /// Reference sound speed c0.
+    pub fn sound_speed(&self) -> f64 {
+        if self.solver.sound_speed > 0.0 {
+            return self.solver.sound_speed;
+        }
+        let href = if self.solver.reference_height > 0.0 { self.solver.reference_height } else { self.fill.height };
+        self.solver.sound_speed_coefficient * (self.gravity * href).sqrt()
+    }
+
+    /// Wall layers actually built.
+    pub fn wall_layers(&self) -> u32 {
+        if self.solver.boundary.layers > 0 {
+            self.solver.boundary.layers
+        } else {
+            (2.0 * self.solver.smoothing_ratio).ceil() as u32
+        }
+    }
+
+    /// Checks every field; the error names the first unusable one.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        if self.dimension != 2 && self.dimension != 3 {
+            return Err(err("dimension", format!("must be 2 or 3, got {}", self.dimension)));
+        }
+        positive("tank.length", self.tank.length)?;
+        positive("tank.breadth", self.tank.breadth)?;
+        positive("tank.height", self.tank.height)?;
+        positive("particle_spacing", self.particle_spacing)?;
+        positive("fill_height", self.fill.height)?;
+        non_negative("fill_length", self.fill.length)?;
+        positive("fluid.density", self.fluid.density)?;
+        non_negative("fluid.kinematic_viscosity", self.fluid.kinematic_viscosity)?;
+        non_negative("gravity", self.gravity)?;
+        let dp = self.particle_spacing;
+        if self.fill.height > self.tank.height {
+            return Err(err("fill_height", format!("{} m is above the tank height {} m", self.fill.height, self.tank.height)));
+        }
+        if self.fill.length > self.tank.length {
+            return Err(err("fill_length", format!("{} m is longer than the tank ({} m)", self.fill.length, self.tank.length)));
+        }
+        let min_extent = if self.dimension == 3 { self.tank.breadth.min(self.tank.length) } else { self.tank.length };
+        if min_extent < 4.0 * dp || self.tank.height < 4.0 * dp {
+            return Err(err("particle_spacing", format!("{dp} m is too coarse for the tank: use at most a quarter of its smallest side")));
+        }
+        if self.fill.height < 2.0 * dp {
+            return Err(err("fill_height", format!("{} m is less than two particle spacings ({dp} m)", self.fill.height)));
+        }
+        let s = &self.solver;
+        if !(s.smoothing_ratio >= 0.9 && s.smoothing_ratio <= 3.0) {
+            return Err(err("solver.smoothing_ratio", format!("h/dp must be within 0.9..3, got {}", s.smoothing_ratio)));
+        }
+        if !(s.cfl > 0.0 && s.cfl <= 1.0) {
+            return Err(err("solver.cfl", format!("must be within (0, 1], got {}", s.cfl)));
+        }
+        positive("solver.sound_speed_coefficient", s.sound_speed_coefficient)?;
+        non_negative("solver.reference_height", s.reference_height)?;
+        non_negative("solver.sound_speed", s.sound_speed)?;
+        non_negative("solver.artificial_viscosity.alpha", s.artificial_viscosity.alpha)?;
+        non_negative("solver.artificial_viscosity.beta", s.artificial_viscosity.beta)?;
+        positive("solver.artificial_viscosity.eta_factor", s.artificial_viscosity.eta_factor)?;
+        non_negative("solver.density_diffusion.delta", s.density_diffusion.delta)?;
+        non_negative("solver.dt_min", s.dt_min)?;
+        positive("solver.dt_max", s.dt_max)?;
+        if s.verlet_reset_steps == 0 {
+            return Err(err("solver.verlet_reset_steps", "must be at least 1"));
+        }
+        if s.laminar_viscosity && self.fluid.kinematic_viscosity <= 0.0 {
+            return Err(err("fluid.kinematic_viscosity", "must be positive when solver.laminar_viscosity is on"));
+        }
+        if self.gravity == 0.0 && s.sound_speed <= 0.0 {
+            return Err(err("solver.sound_speed", "set an explicit sound speed when gravity is 0"));
+        }
+        let (hl, hb) = (self.tank.length / 2.0, self.tank.breadth / 2.0);
+        for (i, p) in self.probes.iter().enumerate() {
+            if !(p.x.abs() < hl) {
+                return Err(err("probes.x", format!("probe {i} ({}) at x = {} m is outside the tank (|x| < {hl})", p.name, p.x)));
+            }
+            if self.dimension == 3 && !(p.y.abs() < hb) {
+                return Err(err("probes.y", format!("probe {i} ({}) at y = {} m is outside the tank (|y| < {hb})", p.name, p.y)));
+            }
+        }
+        for (i, p) in self.pressure_sensors.iter().enumerate() {
+            let tol = 1e-9;
+            if !(p.x.abs() <= hl + tol) {
+                return Err(err("pressure_sensors.x", format!("sensor {i} ({}) at x = {} m is outside the tank", p.name, p.x)));
+            }
+            if self.dimension == 3 && !(p.y.abs() <= hb + tol) {
+                return Err(err("pressure_sensors.y", format!("sensor {i} ({}) at y = {} m is outside the tank", p.name, p.y)));
+            }
+            if !(p.z >= -tol && p.z <= self.tank.height + tol) {
+                return Err(err("pressure_sensors.z", format!("sensor {i} ({}) at z = {} m is outside the tank", p.name, p.z)));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,222 @@
+//! Particle storage, struct of arrays. The integrated state is f64 (positions relative to the tank origin,
+//! velocities relative to the tank frame, densities); the interaction loops read f32 copies refreshed before
+//! each force evaluation, in the same cell-sorted order.
+
+use crate::neighbours::{counting_sort, permute, Grid, OUTSIDE};
+
+/// The liquid.
+#[derive(Clone, Debug)]
+pub struct Fluid<const D: usize> {
+    // Integrated state (f64).
+    pub pos: [Vec<f64>; D],
+    pub vel: [Vec<f64>; D],
+    pub rho: Vec<f64>,
+    /// State at the start of the step (symplectic) or the previous step (Verlet).
+    pub pos0: [Vec<f64>; D],
+    pub vel0: [Vec<f64>; D],
+    pub rho0: Vec<f64>,
+    /// Original index of each particle (stable through sorting).
+    pub id: Vec<u32>,
+    // Interaction copies (f32) and cell of each particle, refreshed every force evaluation.
+    pub x: [Vec<f32>; D],
+    pub v: [Vec<f32>; D],
+    pub r: Vec<f32>,
+    pub p: Vec<f32>,
+    pub cell: Vec<u32>,
+    /// Cell offsets of the sorted particles.
+    pub starts: Vec<u32>,
+    // Rates from the last force evaluation.
+    pub acc: Vec<[f32; D]>,
+    pub drho: Vec<f32>,
+}
+
+/// Scratch buffers for sorting, kept to avoid allocating inside a step.
+#[derive(Clone, Debug, Default)]
+pub struct SortScratch {
+    dest: Vec<u32>,
+    f64s: Vec<f64>,
+    f32s: Vec<f32>,
+    u32s: Vec<u32>,
+}
+
+fn vecs<T, const D: usize>() -> [Vec<T>; D] {
+    std::array::from_fn(|_| Vec::new())
+}
+
+impl<const D: usize> Default for Fluid<D> {
+    fn default() -> Self {
+        Self {
+            pos: vecs(),
+            vel: vecs(),
+            rho: Vec::new(),
+            pos0: vecs(),
+            vel0: vecs(),
+            rho0: Vec::new(),
+            id: Vec::new(),
+            x: vecs(),
+            v: vecs(),
+            r: Vec::new(),
+            p: Vec::new(),
+            cell: Vec::new(),
+            starts: Vec::new(),
+            acc: Vec::new(),
+            drho: Vec::new(),
+        }
+    }
+}
+
+impl<const D: usize> Default for Boundary<D> {
+    fn default() -> Self {
+        Self {
+            x: vecs(),
+            v: vecs(),
+            rho: Vec::new(),
+            rho0: Vec::new(),
+            r: Vec::new(),
+            p: Vec::new(),
+            cell: Vec::new(),
+            starts: Vec::new(),
+            drho: Vec::new(),
+        }
+    }
+}
+
+impl<const D: usize> Fluid<D> {
+    pub fn new(points: &[[f64; D]], density: impl Fn([f64; D]) -> f64) -> Self {
+        let mut f = Self::default();
+        for k in 0..D {
+            f.pos[k] = points.iter().map(|p| p[k]).collect();
+            f.vel[k] = vec![0.0; points.len()];
+        }
+        f.rho = points.iter().map(|p| density(*p)).collect();
+        f.pos0 = f.pos.clone();
+        f.vel0 = f.vel.clone();
+        f.rho0 = f.rho.clone();
+        f.id = (0..points.len() as u32).collect();
+        f
+    }
+
+    pub fn len(&self) -> usize {
+        self.rho.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.rho.is_empty()
+    }
+
+    #[inline]
+    pub fn position(&self, i: usize) -> [f64; D] {
+        std::array::from_fn(|k| self.pos[k][i])
+    }
+
+    /// Sorts all per-particle arrays by cell and drops particles that left the grid. Returns how many left.
+    pub fn sort(&mut self, grid: &Grid<D>, scratch: &mut SortScratch) -> usize {
+        let n = self.len();
+        let mut cells = std::mem::take(&mut self.cell);
+        cells.clear();
+        cells.extend((0..n).map(|i| grid.cell_of(self.position(i))));
+        self.cell = cells;
+        let keep = counting_sort(grid.n_cells(), &self.cell, &mut self.starts, &mut scratch.dest);
+        let dest = &scratch.dest;
+        let s = &mut scratch.f64s;
+        for k in 0..D {
+            permute(&mut self.pos[k], dest, s, keep);
+            permute(&mut self.vel[k], dest, s, keep);
+            permute(&mut self.pos0[k], dest, s, keep);
+            permute(&mut self.vel0[k], dest, s, keep);
+        }
+        permute(&mut self.rho, dest, s, keep);
+        permute(&mut self.rho0, dest, s, keep);
+        permute(&mut self.id, dest, &mut scratch.u32s, keep);
+        permute(&mut self.cell, dest, &mut scratch.u32s, keep);
+        debug_assert!(self.cell.iter().all(|&c| c != OUTSIDE));
+        n - keep
+    }
+
+    /// Refreshes the f32 copies and pressures from the integrated state.
+    pub fn refresh(&mut self, eos: impl Fn(f32) -> f32 + Sync) {
+        let n = self.len();
+        for k in 0..D {
+            self.x[k].clear();
+            self.x[k].extend(self.pos[k].iter().map(|&v| v as f32));
+            self.v[k].clear();
+            self.v[k].extend(self.vel[k].iter().map(|&v| v as f32));
+        }
+        self.r.clear();
+        self.r.extend(self.rho.iter().map(|&v| v as f32));
+        self.p.clear();
+        self.p.extend(self.r.iter().map(|&r| eos(r)));
+        self.acc.resize(n, [0.0; D]);
+        self.drho.resize(n, 0.0);
+    }
+}
+
+/// Boundary particles: the tank's wall layers (fixed in the tank frame) or mirror ghosts (rebuilt each
+/// force evaluation). Velocities are relative to the tank frame, so zero for wall layers.
+#[derive(Clone, Debug)]
+pub struct Boundary<const D: usize> {
+    pub x: [Vec<f32>; D],
+    pub v: [Vec<f32>; D],
+    /// Density (integrated by continuity for wall layers).
+    pub rho: Vec<f64>,
+    pub rho0: Vec<f64>,
+    pub r: Vec<f32>,
+    pub p: Vec<f32>,
+    pub cell: Vec<u32>,
+    pub starts: Vec<u32>,
+    pub drho: Vec<f32>,
+}
+
+impl<const D: usize> Boundary<D> {
+    pub fn len(&self) -> usize {
+        self.r.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.r.is_empty()
+    }
+
+    pub fn clear(&mut self) {
+        for k in 0..D {
+            self.x[k].clear();
+            self.v[k].clear();
+        }
+        self.rho.clear();
+        self.rho0.clear();
+        self.r.clear();
+        self.p.clear();
+    }
+
+    pub fn push(&mut self, x: [f64; D], v: [f64; D], rho: f64, p: f32) {
+        for k in 0..D {
+            self.x[k].push(x[k] as f32);
+            self.v[k].push(v[k] as f32);
+        }
+        self.rho.push(rho);
+        self.rho0.push(rho);
+        self.r.push(rho as f32);
+        self.p.push(p);
+    }
+
+    /// Sorts by cell (points off the grid are dropped: they cannot reach any fluid particle).
+    pub fn sort(&mut self, grid: &Grid<D>, scratch: &mut SortScratch) {
+        let n = self.len();
+        let mut cells = std::mem::take(&mut self.cell);
+        cells.clear();
+        cells.extend((0..n).map(|i| grid.cell_of(std::array::from_fn(|k| self.x[k][i] as f64))));
+        self.cell = cells;
+        let keep = counting_sort(grid.n_cells(), &self.cell, &mut self.starts, &mut scratch.dest);
+        let dest = &scratch.dest;
+        let s32 = &mut scratch.f32s;
+        for k in 0..D {
+            permute(&mut self.x[k], dest, s32, keep);
+            permute(&mut self.v[k], dest, s32, keep);
+        }
+        permute(&mut self.r, dest, s32, keep);
+        permute(&mut self.p, dest, s32, keep);
+        permute(&mut self.rho, dest, &mut scratch.f64s, keep);
+        permute(&mut self.rho0, dest, &mut scratch.f64s, keep);
+        permute(&mut self.cell, dest, &mut scratch.u32s, keep);
+        self.drho.resize(keep, 0.0);
+    }
+}

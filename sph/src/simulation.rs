@@ -1,0 +1,388 @@
+//! A liquid in a moving tank: the stage sequence of one step, readable top to bottom.
+//!
+//! The liquid is integrated in the tank frame. The tank's motion enters only as the apparent gravity
+//! R^T (g − a) and the rotation terms (Euler, centrifugal, Coriolis), so the result does not depend on where
+//! the tank is in the world, and positions keep their precision relative to the tank origin.
+
+use crate::boundary::{dynamic, mirror};
+use crate::eos::Tait;
+use crate::error::SimError;
+use crate::integrate;
+use crate::kernel::Kernel;
+use crate::motion::TankMotion;
+use crate::neighbours::Grid;
+use crate::observe::probes::Shell;
+use crate::observe::{pressure, probes, Observation, Wrench};
+use crate::params::{BoundaryMethod, Integrator, SimParams};
+use crate::particles::{Boundary, Fluid, SortScratch};
+use crate::scheme::wcsph::{self, Coefficients};
+use crate::scheme::{FrameTerms, PassTotals};
+use crate::tank::{fluid_lattice, from3, to3, wall_lattice, TankBox};
+
+/// Particle counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Counts {
+    pub fluid: usize,
+    pub boundary: usize,
+    /// Liquid particles that left the tank (removed).
+    pub lost: usize,
+}
+
+/// Statistics of the run so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Stats {
+    pub steps: u64,
+    pub force_evaluations: u64,
+    pub last_dt: f64,
+    pub min_dt: f64,
+}
+
+pub struct Simulation<const D: usize, K: Kernel> {
+    params: SimParams,
+    kernel: K,
+    coef: Coefficients,
+    eos: Tait,
+    grid: Grid<D>,
+    tank: TankBox<D>,
+    fluid: Fluid<D>,
+    /// Wall layers (dynamic method) or mirror ghosts.
+    bound: Boundary<D>,
+    shell: Shell<D>,
+    time: f64,
+    stats: Stats,
+    lost: usize,
+    dt_min: f64,
+    /// Totals of the last force evaluation, and whether the rates belong to the current state.
+    last: PassTotals,
+    rates_current: bool,
+    scratch: SortScratch,
+    partials: Vec<PassTotals>,
+}
+
+impl<const D: usize, K: Kernel> Simulation<D, K> {
+    pub fn new(params: SimParams) -> Result<Self, SimError> {
+        params.validate()?;
+        assert_eq!(params.dimension, D, "dimension mismatch");
+        let dp = params.particle_spacing;
+        let h = params.h();
+        let c0 = params.sound_speed();
+        let rho0 = params.fluid.density;
+        let eos = Tait::new(rho0, c0);
+        let kernel = K::new(D, h as f32);
+        let tank = TankBox::<D>::new(&params);
+        let layers = params.wall_layers();
+        let support = kernel.support() as f64;
+
+        // Grid over the tank, its wall layers and one kernel support beyond.
+        let shell_layers = layers.max((support / dp).ceil() as u32 + 1);
+        let margin = shell_layers as f64 * dp + support;
+        let lo: [f64; D] = std::array::from_fn(|k| tank.lo[k] - margin);
+        let hi: [f64; D] = std::array::from_fn(|k| tank.hi[k] + margin);
+        let grid = Grid::new(lo, hi, support);
+
+        // Liquid at rest with hydrostatic pressure below its own top.
+        let (points, volume) = fluid_lattice::<D>(&params);
+        let (g, top) = (params.gravity, params.fill.height);
+        let fill_x1 = tank.lo[0] + params.fill_length();
+        let hydro = move |x: [f64; D]| -> f64 {
+            let z = x[D - 1];
+            if x[0] <= fill_x1 + 0.5 * dp {
+                eos.density(rho0 * g * (top - z.min(top)))
+            } else {
+                rho0
+            }
+        };
+        let mut fluid = Fluid::new(&points, hydro);
+        let m_fluid = rho0 * volume;
+
+        let (wall_pts, wall_volume) = wall_lattice::<D>(&params, layers);
+        let mut scratch = SortScratch::default();
+        let mut bound = match params.solver.boundary.method {
+            BoundaryMethod::Dynamic => dynamic::build(&wall_pts, hydro, &eos),
+            BoundaryMethod::Mirror => Boundary::default(),
+        };
+        bound.sort(&grid, &mut scratch);
+        let (shell_pts, shell_volume) = wall_lattice::<D>(&params, shell_layers);
+        let mut shell = Shell { points: dynamic::build(&shell_pts, |_| rho0, &eos), volume: shell_volume as f32 };
+        shell.points.sort(&grid, &mut scratch);
+        fluid.sort(&grid, &mut scratch);
+
+        let s = &params.solver;
+        let coef = Coefficients {
+            h: h as f32,
+            support2: (support * support) as f32,
+            m_fluid: m_fluid as f32,
+            m_bound: (rho0 * wall_volume) as f32,
+            rho0: rho0 as f32,
+            c0: c0 as f32,
+            alpha: s.artificial_viscosity.alpha as f32,
+            beta: s.artificial_viscosity.beta as f32,
+            eta2: (s.artificial_viscosity.eta_factor * h * h) as f32,
+            diffusion: s.density_diffusion.kind,
+            delta_h_c0: (s.density_diffusion.delta * h * c0) as f32,
+            nu4: if s.laminar_viscosity { (4.0 * params.fluid.kinematic_viscosity) as f32 } else { 0.0 },
+        };
+        let dt_min = if s.dt_min > 0.0 { s.dt_min } else { 1e-4 * s.cfl * h / c0 };
+        Ok(Self {
+            params,
+            kernel,
+            coef,
+            eos,
+            grid,
+            tank,
+            fluid,
+            bound,
+            shell,
+            time: 0.0,
+            stats: Stats { min_dt: f64::INFINITY, ..Default::default() },
+            lost: 0,
+            dt_min,
+            last: PassTotals::default(),
+            rates_current: false,
+            scratch,
+            partials: Vec::new(),
+        })
+    }
+
+    /// The frame terms of the motion at t.
+    fn frame(&self, motion: &dyn TankMotion, t: f64) -> FrameTerms {
+        let s = motion.state(t);
+        let f = |v: nalgebra::Vector3<f64>| [v.x as f32, v.y as f32, v.z as f32];
+        FrameTerms { g: f(s.apparent_gravity(self.params.gravity)), w: f(s.angular_velocity), dw: f(s.angular_acceleration) }
+    }
+
+    /// Evaluates the rates at time t for the current state. `sort` re-bins the liquid first (once a step).
+    fn evaluate(&mut self, motion: &dyn TankMotion, t: f64, sort: bool) -> Result<(), SimError> {
+        let frame = self.frame(motion, t);
+        if sort {
+            self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
+            if self.fluid.is_empty() {
+                return Err(SimError::AllParticlesLost { time: t });
+            }
+        }
+        let eos = self.eos;
+        self.fluid.refresh(|r| eos.pressure(r));
+        match self.params.solver.boundary.method {
+            BoundaryMethod::Dynamic => dynamic::refresh(&mut self.bound, &eos),
+            BoundaryMethod::Mirror => {
+                let g: [f64; D] = from3(frame.g.map(|v| v as f64));
+                mirror::build_ghosts(&self.fluid, &self.tank, self.kernel.support() as f64, g, &eos, &mut self.bound);
+                self.bound.sort(&self.grid, &mut self.scratch);
+            }
+        }
+        self.last = wcsph::fluid_rates(&self.kernel, &self.coef, &self.grid, &frame, &mut self.fluid, &self.bound, &mut self.partials);
+        if self.params.solver.boundary.method == BoundaryMethod::Dynamic {
+            wcsph::wall_density_rates(&self.kernel, &self.coef, &self.grid, &self.fluid, &mut self.bound);
+        }
+        self.stats.force_evaluations += 1;
+        if self.last.non_finite {
+            return Err(SimError::NonFinite { time: t, step: self.stats.steps });
+        }
+        Ok(())
+    }
+
+    /// CFL time step from the last evaluation: dt = CFL · min(sqrt(h/|a|max), h/(c_max + max|μ|)).
+    fn time_step(&self) -> Result<f64, SimError> {
+        let s = &self.params.solver;
+        let h = self.coef.h as f64;
+        let rmax = self.fluid.r.iter().fold(self.coef.rho0, |m, &r| m.max(r));
+        let cmax = self.eos.sound_speed(rmax) as f64;
+        let dt_f = if self.last.max_acc > 0.0 { (h / self.last.max_acc as f64).sqrt() } else { f64::INFINITY };
+        let dt_cv = h / (cmax + self.last.max_mu as f64);
+        let mut dt = s.cfl * dt_f.min(dt_cv);
+        if s.laminar_viscosity {
+            dt = dt.min(0.125 * h * h / self.params.fluid.kinematic_viscosity);
+        }
+        dt = dt.min(s.dt_max);
+        if !(dt >= self.dt_min) {
+            return Err(SimError::TimeStepCollapsed { time: self.time, step: self.stats.steps, dt, dt_min: self.dt_min });
+        }
+        Ok(dt)
+    }
+
+    /// Advances one time step; returns its length.
+    pub fn step(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
+        let t = self.time;
+        if !self.rates_current {
+            self.evaluate(motion, t, true)?;
+        }
+        self.rates_current = false;
+        let dt = self.time_step()?;
+        if t + dt > motion.end_time() + 1e-12 {
+            return Err(SimError::MotionEnded { time: t + dt, end: motion.end_time() });
+        }
+        let walls = self.params.solver.boundary.method == BoundaryMethod::Dynamic;
+        match self.params.solver.integrator {
+            Integrator::Symplectic => {
+                integrate::symplectic_predict(&mut self.fluid, walls.then_some(&mut self.bound), dt);
+                if walls {
+                    dynamic::clamp(&mut self.bound, self.eos.rho0 as f64);
+                }
+                self.evaluate(motion, t + 0.5 * dt, false)?;
+                integrate::symplectic_correct(&mut self.fluid, walls.then_some(&mut self.bound), dt);
+            }
+            Integrator::Verlet => {
+                let euler = self.stats.steps % self.params.solver.verlet_reset_steps as u64 == 0;
+                integrate::verlet(&mut self.fluid, walls.then_some(&mut self.bound), dt, euler);
+            }
+        }
+        if walls {
+            dynamic::clamp(&mut self.bound, self.eos.rho0 as f64);
+        } else {
+            mirror::restrain(&mut self.fluid, &self.tank, 0.25 * self.params.particle_spacing);
+        }
+        self.time = t + dt;
+        self.stats.steps += 1;
+        self.stats.last_dt = dt;
+        self.stats.min_dt = self.stats.min_dt.min(dt);
+        Ok(dt)
+    }
+
+    /// Steps until the simulation time reaches `t_end`.
+    pub fn advance_to(&mut self, motion: &dyn TankMotion, t_end: f64) -> Result<(), SimError> {
+        while self.time < t_end {
+            self.step(motion)?;
+        }
+        Ok(())
+    }
+
+    /// Observables of the current state (evaluates the rates of the current state if the last step did not).
+    pub fn observe(&mut self, motion: &dyn TankMotion) -> Result<Observation, SimError> {
+        if !self.rates_current {
+            self.evaluate(motion, self.time, true)?;
+            self.rates_current = true;
+        }
+        let k = &self.kernel;
+        let m = self.coef.m_fluid;
+        let dp = self.params.particle_spacing;
+        let top = self.params.tank.height;
+        let probes = self
+            .params
+            .probes
+            .iter()
+            .map(|p| probes::elevation(k, &self.grid, &self.fluid, m, &self.shell, [p.x, p.y], top, 0.25 * dp))
+            .collect();
+        let pressures = self
+            .params
+            .pressure_sensors
+            .iter()
+            .map(|s| pressure::pressure(k, &self.grid, &self.fluid, m, from3([s.x, s.y, s.z])))
+            .collect();
+        // The boundary's force on the liquid, reversed; a 2D result stands for the tank's breadth.
+        let scale = if D == 2 { -self.params.tank.breadth } else { -1.0 };
+        let wrench = Wrench { force: self.last.force.map(|v| v * scale), moment: self.last.moment.map(|v| v * scale) };
+        Ok(Observation { time: self.time, probes, pressures, wrench })
+    }
+
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    pub fn counts(&self) -> Counts {
+        Counts { fluid: self.fluid.len(), boundary: self.bound.len(), lost: self.lost }
+    }
+
+    pub fn params(&self) -> &SimParams {
+        &self.params
+    }
+
+    /// Mass of the liquid, kg (a 2D run: for the tank's breadth).
+    pub fn liquid_mass(&self) -> f64 {
+        let m = self.fluid.len() as f64 * self.coef.m_fluid as f64;
+        if D == 2 {
+            m * self.params.tank.breadth
+        } else {
+            m
+        }
+    }
+
+    /// Liquid particle positions in the tank frame as x, y, z.
+    pub fn fluid_positions(&self) -> Vec<[f64; 3]> {
+        (0..self.fluid.len()).map(|i| to3(self.fluid.position(i))).collect()
+    }
+
+    /// Liquid particle velocities relative to the tank as x, y, z.
+    pub fn fluid_velocities(&self) -> Vec<[f64; 3]> {
+        (0..self.fluid.len()).map(|i| to3(std::array::from_fn::<f64, D, _>(|k| self.fluid.vel[k][i]))).collect()
+    }
+
+    /// Sets every liquid particle's velocity from its position (x, y, z in, x, y, z out): initial conditions.
+    pub fn set_fluid_velocity(&mut self, f: &dyn Fn([f64; 3]) -> [f64; 3]) {
+        for i in 0..self.fluid.len() {
+            let v: [f64; D] = from3(f(to3(self.fluid.position(i))));
+            for k in 0..D {
+                self.fluid.vel[k][i] = v[k];
+                self.fluid.vel0[k][i] = v[k];
+            }
+        }
+        self.rates_current = false;
+    }
+}
+
+/// A simulation of any dimension and kernel, chosen at run time.
+pub trait Solver: Send {
+    fn step(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError>;
+    fn advance_to(&mut self, motion: &dyn TankMotion, t_end: f64) -> Result<(), SimError>;
+    fn observe(&mut self, motion: &dyn TankMotion) -> Result<Observation, SimError>;
+    fn time(&self) -> f64;
+    fn stats(&self) -> Stats;
+    fn counts(&self) -> Counts;
+    fn params(&self) -> &SimParams;
+    fn liquid_mass(&self) -> f64;
+    fn fluid_positions(&self) -> Vec<[f64; 3]>;
+    fn fluid_velocities(&self) -> Vec<[f64; 3]>;
+    fn set_fluid_velocity(&mut self, f: &dyn Fn([f64; 3]) -> [f64; 3]);
+}
+
+impl<const D: usize, K: Kernel> Solver for Simulation<D, K> {
+    fn step(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
+        Simulation::step(self, motion)
+    }
+    fn advance_to(&mut self, motion: &dyn TankMotion, t_end: f64) -> Result<(), SimError> {
+        Simulation::advance_to(self, motion, t_end)
+    }
+    fn observe(&mut self, motion: &dyn TankMotion) -> Result<Observation, SimError> {
+        Simulation::observe(self, motion)
+    }
+    fn time(&self) -> f64 {
+        self.time
+    }
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+    fn counts(&self) -> Counts {
+        Simulation::counts(self)
+    }
+    fn params(&self) -> &SimParams {
+        &self.params
+    }
+    fn liquid_mass(&self) -> f64 {
+        Simulation::liquid_mass(self)
+    }
+    fn fluid_positions(&self) -> Vec<[f64; 3]> {
+        Simulation::fluid_positions(self)
+    }
+    fn fluid_velocities(&self) -> Vec<[f64; 3]> {
+        Simulation::fluid_velocities(self)
+    }
+    fn set_fluid_velocity(&mut self, f: &dyn Fn([f64; 3]) -> [f64; 3]) {
+        Simulation::set_fluid_velocity(self, f)
+    }
+}
+
+/// Builds the simulation the parameters ask for.
+pub fn build(params: SimParams) -> Result<Box<dyn Solver>, SimError> {
+    use crate::kernel::{CubicSpline, KernelKind, WendlandC2};
+    params.validate()?;
+    Ok(match (params.dimension, params.solver.kernel) {
+        (2, KernelKind::CubicSpline) => Box::new(Simulation::<2, CubicSpline>::new(params)?),
+        (2, KernelKind::Wendland) => Box::new(Simulation::<2, WendlandC2>::new(params)?),
+        (3, KernelKind::CubicSpline) => Box::new(Simulation::<3, CubicSpline>::new(params)?),
+        (_, KernelKind::Wendland) => Box::new(Simulation::<3, WendlandC2>::new(params)?),
+        (_, KernelKind::CubicSpline) => Box::new(Simulation::<3, CubicSpline>::new(params)?),
+    })
+}

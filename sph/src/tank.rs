@@ -1,0 +1,146 @@
+//! Tank geometry in the tank frame and the particle lattices that fill it. Axis k of a D-dimensional point is
+//! x, z in 2D and x, y, z in 3D; [`to3`] and [`from3`] convert.
+
+use crate::params::SimParams;
+
+/// A D-dimensional point or vector as x, y, z (y = 0 in 2D).
+#[inline(always)]
+pub fn to3<T: Copy + Default, const D: usize>(p: [T; D]) -> [T; 3] {
+    if D == 2 {
+        [p[0], T::default(), p[1]]
+    } else {
+        [p[0], p[1], p[2]]
+    }
+}
+
+/// The D-dimensional part of an x, y, z triple.
+#[inline(always)]
+pub fn from3<T: Copy + Default, const D: usize>(p: [T; 3]) -> [T; D] {
+    let mut out = [T::default(); D];
+    if D == 2 {
+        out[0] = p[0];
+        out[1] = p[2];
+    } else {
+        out.copy_from_slice(&p);
+    }
+    out
+}
+
+/// The inside of the tank as an axis-aligned box in the tank frame.
+#[derive(Clone, Copy, Debug)]
+pub struct TankBox<const D: usize> {
+    pub lo: [f64; D],
+    pub hi: [f64; D],
+}
+
+impl<const D: usize> TankBox<D> {
+    pub fn new(p: &SimParams) -> Self {
+        let lo = from3([-p.tank.length / 2.0, -p.tank.breadth / 2.0, 0.0]);
+        let hi = from3([p.tank.length / 2.0, p.tank.breadth / 2.0, p.tank.height]);
+        Self { lo, hi }
+    }
+
+    pub fn contains(&self, x: [f64; D]) -> bool {
+        (0..D).all(|k| x[k] >= self.lo[k] && x[k] <= self.hi[k])
+    }
+}
+
+/// Lattice spacing along one axis: the number of cells nearest to extent/dp, and the spacing that fits exactly.
+fn axis(extent: f64, dp: f64) -> (usize, f64) {
+    let n = ((extent / dp).round() as usize).max(1);
+    (n, extent / n as f64)
+}
+
+/// Initial liquid particles (a block against the −x wall) and the volume each stands for
+/// (m³, or m² per unit breadth in 2D). Spacing is adjusted per axis so the block is filled exactly.
+pub fn fluid_lattice<const D: usize>(p: &SimParams) -> (Vec<[f64; D]>, f64) {
+    let dp = p.particle_spacing;
+    let tank = TankBox::<D>::new(p);
+    let extent: [f64; D] = from3([p.fill_length(), p.tank.breadth, p.fill.height]);
+    let ax: Vec<(usize, f64)> = (0..D).map(|k| axis(extent[k], dp)).collect();
+    let volume: f64 = ax.iter().map(|a| a.1).product();
+    let total: usize = ax.iter().map(|a| a.0).product();
+    let mut out = Vec::with_capacity(total);
+    for i in 0..total {
+        let mut rest = i;
+        let mut x = [0.0; D];
+        for k in 0..D {
+            let (n, s) = ax[k];
+            x[k] = tank.lo[k] + ((rest % n) as f64 + 0.5) * s;
+            rest /= n;
+        }
+        out.push(x);
+    }
+    (out, volume)
+}
+
+/// `layers` of lattice points outside the tank's inner faces, corners included, and the volume of each.
+pub fn wall_lattice<const D: usize>(p: &SimParams, layers: u32) -> (Vec<[f64; D]>, f64) {
+    let dp = p.particle_spacing;
+    let tank = TankBox::<D>::new(p);
+    let ax: Vec<(usize, f64)> = (0..D).map(|k| axis(tank.hi[k] - tank.lo[k], dp)).collect();
+    let volume: f64 = ax.iter().map(|a| a.1).product();
+    let l = layers as i64;
+    let counts: Vec<i64> = ax.iter().map(|a| a.0 as i64 + 2 * l).collect();
+    let total: i64 = counts.iter().product();
+    let mut out = Vec::new();
+    for i in 0..total {
+        let mut rest = i;
+        let mut x = [0.0; D];
+        let mut inside = true;
+        for k in 0..D {
+            let idx = rest % counts[k] - l;
+            rest /= counts[k];
+            let (n, s) = ax[k];
+            inside &= idx >= 0 && idx < n as i64;
+            x[k] = tank.lo[k] + (idx as f64 + 0.5) * s;
+        }
+        if !inside {
+            out.push(x);
+        }
+    }
+    (out, volume)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::*;
+
+    fn params(dim: usize) -> SimParams {
+        SimParams {
+            dimension: dim,
+            tank: TankSpec { length: 0.8, breadth: 0.25, height: 0.6 },
+            fill: FillSpec { height: 0.39, length: 0.0 },
+            particle_spacing: 0.02,
+            fluid: FluidSpec::default(),
+            gravity: 9.81,
+            solver: SolverSpec::default(),
+            probes: vec![],
+            pressure_sensors: vec![],
+        }
+    }
+
+    #[test]
+    fn fluid_block_fills_exactly_the_requested_volume() {
+        let p = params(3);
+        let (pts, v) = fluid_lattice::<3>(&p);
+        // 0.25 / 0.02 = 12.5 rounds to 13 cells of 19.2 mm across the breadth.
+        assert_eq!(pts.len(), 40 * 13 * 20);
+        assert!((pts.len() as f64 * v - 0.8 * 0.25 * 0.39).abs() < 1e-12);
+        let p2 = params(2);
+        let (pts2, v2) = fluid_lattice::<2>(&p2);
+        assert!((pts2.len() as f64 * v2 - 0.8 * 0.39).abs() < 1e-12);
+        assert!(pts2.iter().all(|x| x[0] > -0.4 && x[0] < 0.4 && x[1] > 0.0 && x[1] < 0.39));
+    }
+
+    #[test]
+    fn walls_surround_the_tank() {
+        let p = params(2);
+        let (w, _) = wall_lattice::<2>(&p, 3);
+        // (40 + 6) × (30 + 6) − 40 × 30
+        assert_eq!(w.len(), 46 * 36 - 40 * 30);
+        let b = TankBox::<2>::new(&p);
+        assert!(w.iter().all(|x| !b.contains(*x)));
+    }
+}

@@ -1,0 +1,1 @@
+//! End-to-end and validation tests live in `tests/tests/`.
