@@ -80,11 +80,15 @@ pub struct ArtificialViscosity {
     pub beta: f64,
     /// η² = eta_factor · h² regularises 1/r² (the paper: 0.01).
     pub eta_factor: f64,
+    /// Multiplies α and β between liquid and wall particles (DualSPHysics' ViscoBoundFactor). At 1 the walls
+    /// act as no-slip with the artificial viscosity, which at sloshing resolutions is hundreds of times
+    /// water's and over-damps sloshing; 0 (default) leaves wall friction to `solver.laminar_viscosity`.
+    pub boundary_factor: f64,
 }
 
 impl Default for ArtificialViscosity {
     fn default() -> Self {
-        Self { alpha: 0.02, beta: 0.0, eta_factor: 0.01 }
+        Self { alpha: 0.02, beta: 0.0, eta_factor: 0.01, boundary_factor: 0.0 }
     }
 }
 
@@ -313,6 +317,7 @@ impl SimParams {
         non_negative("solver.artificial_viscosity.alpha", s.artificial_viscosity.alpha)?;
         non_negative("solver.artificial_viscosity.beta", s.artificial_viscosity.beta)?;
         positive("solver.artificial_viscosity.eta_factor", s.artificial_viscosity.eta_factor)?;
+        non_negative("solver.artificial_viscosity.boundary_factor", s.artificial_viscosity.boundary_factor)?;
         non_negative("solver.density_diffusion.delta", s.density_diffusion.delta)?;
         non_negative("solver.dt_min", s.dt_min)?;
         positive("solver.dt_max", s.dt_max)?;

@@ -117,6 +117,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             c0: c0 as f32,
             alpha: s.artificial_viscosity.alpha as f32,
             beta: s.artificial_viscosity.beta as f32,
+            alpha_bound: (s.artificial_viscosity.alpha * s.artificial_viscosity.boundary_factor) as f32,
+            beta_bound: (s.artificial_viscosity.beta * s.artificial_viscosity.boundary_factor) as f32,
             eta2: (s.artificial_viscosity.eta_factor * h * h) as f32,
             diffusion: s.density_diffusion.kind,
             delta_h_c0: (s.density_diffusion.delta * h * c0) as f32,

@@ -28,6 +28,9 @@ pub struct Coefficients {
     pub c0: f32,
     pub alpha: f32,
     pub beta: f32,
+    /// α and β between liquid and boundary particles.
+    pub alpha_bound: f32,
+    pub beta_bound: f32,
     pub eta2: f32,
     pub diffusion: DiffusionKind,
     /// δ h c0.
@@ -69,6 +72,7 @@ fn interact<const D: usize, K: Kernel, const FLUID: bool>(
     let rs = &rho[lo..hi];
     let ps = &p[lo..hi];
     let m = if FLUID { c.m_fluid } else { c.m_bound };
+    let (alpha, beta) = if FLUID { (c.alpha, c.beta) } else { (c.alpha_bound, c.beta_bound) };
     for j in 0..rs.len() {
         let mut dx = [0.0f32; D];
         let mut r2 = 0.0f32;
@@ -92,7 +96,7 @@ fn interact<const D: usize, K: Kernel, const FLUID: bool>(
         if vr < 0.0 {
             let mu = c.h * vr * inv_r2e;
             out.max_mu = out.max_mu.max(-mu);
-            s += (-c.alpha * c.c0 * mu + c.beta * mu * mu) * 2.0 / (ra + rb);
+            s += (-alpha * c.c0 * mu + beta * mu * mu) * 2.0 / (ra + rb);
         }
         let sf = -m * s * f;
         let lam = if c.nu4 > 0.0 { m * c.nu4 * f * r2 * inv_r2e / (ra + rb) } else { 0.0 };
