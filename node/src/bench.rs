@@ -14,9 +14,24 @@ pub struct Case {
 }
 
 pub const CASES: &[Case] = &[
-    Case { name: "dambreak_2d", builtin: "dambreak_2d", overrides: &[], duration: 0.6 },
-    Case { name: "seed_2d_dp8mm", builtin: "seed_tank_039", overrides: &["dimension=2", "particle_spacing=0.008"], duration: 2.0 },
-    Case { name: "seed_3d_dp20mm", builtin: "seed_tank_039", overrides: &["dimension=3", "particle_spacing=0.02"], duration: 1.0 },
+    Case {
+        name: "dambreak_2d",
+        builtin: "dambreak_2d",
+        overrides: &[],
+        duration: 0.6,
+    },
+    Case {
+        name: "seed_2d_dp8mm",
+        builtin: "seed_tank_039",
+        overrides: &["dimension=2", "particle_spacing=0.008"],
+        duration: 2.0,
+    },
+    Case {
+        name: "seed_3d_dp20mm",
+        builtin: "seed_tank_039",
+        overrides: &["dimension=3", "particle_spacing=0.02"],
+        duration: 1.0,
+    },
 ];
 
 #[derive(Debug, Clone, Serialize)]

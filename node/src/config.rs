@@ -11,23 +11,51 @@ use std::path::{Path, PathBuf};
 /// The cases shipped in `launch-configs/`, built into the binary so `slosh run NAME` and `slosh bench` work
 /// anywhere.
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("seed_tank_039", include_str!("../../launch-configs/seed_tank_039.yaml")),
-    ("seed_tank_019", include_str!("../../launch-configs/seed_tank_019.yaml")),
-    ("dambreak_2d", include_str!("../../launch-configs/dambreak_2d.yaml")),
-    ("faltinsen2000_sway", include_str!("../../launch-configs/faltinsen2000_sway.yaml")),
-    ("spheric10", include_str!("../../launch-configs/spheric10.yaml")),
+    (
+        "seed_tank_039",
+        include_str!("../../launch-configs/seed_tank_039.yaml"),
+    ),
+    (
+        "seed_tank_019",
+        include_str!("../../launch-configs/seed_tank_019.yaml"),
+    ),
+    (
+        "dambreak_2d",
+        include_str!("../../launch-configs/dambreak_2d.yaml"),
+    ),
+    (
+        "faltinsen2000_sway",
+        include_str!("../../launch-configs/faltinsen2000_sway.yaml"),
+    ),
+    (
+        "spheric10",
+        include_str!("../../launch-configs/spheric10.yaml"),
+    ),
 ];
 
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     #[error("{source_name}: cannot read: {message}")]
-    Read { source_name: String, message: String },
+    Read {
+        source_name: String,
+        message: String,
+    },
     #[error("{source_name}: not valid YAML: {message}")]
-    Yaml { source_name: String, message: String },
+    Yaml {
+        source_name: String,
+        message: String,
+    },
     #[error("{source_name}: {message}")]
-    Layout { source_name: String, message: String },
+    Layout {
+        source_name: String,
+        message: String,
+    },
     #[error("{source_name}: {key}: {message}")]
-    Key { source_name: String, key: String, message: String },
+    Key {
+        source_name: String,
+        key: String,
+        message: String,
+    },
 }
 
 const DOF_NAMES: &str = "x, y, z, roll, pitch, yaw";
@@ -84,7 +112,13 @@ pub struct IrregularCfg {
 
 impl Default for IrregularCfg {
     fn default() -> Self {
-        Self { significant_amplitude: vec![], peak_period: vec![], gamma: 3.3, components: 128, seed: 1 }
+        Self {
+            significant_amplitude: vec![],
+            peak_period: vec![],
+            gamma: 3.3,
+            components: 128,
+            seed: 1,
+        }
     }
 }
 
@@ -158,13 +192,22 @@ pub struct Loaded {
 pub fn load(path_or_name: &str, overrides: &[String]) -> Result<Loaded, ConfigError> {
     let path = Path::new(path_or_name);
     let (text, source_name, base_dir) = if path.exists() {
-        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Read { source_name: path_or_name.into(), message: e.to_string() })?;
-        (text, path_or_name.to_string(), Some(path.parent().map(Path::to_path_buf).unwrap_or_default()))
+        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Read {
+            source_name: path_or_name.into(),
+            message: e.to_string(),
+        })?;
+        (
+            text,
+            path_or_name.to_string(),
+            Some(path.parent().map(Path::to_path_buf).unwrap_or_default()),
+        )
     } else {
         let name = path_or_name.trim_end_matches(".yaml");
         let name = name.rsplit('/').next().unwrap_or(name);
         match BUILTIN.iter().find(|(n, _)| *n == name) {
-            Some((n, t)) if !path_or_name.contains('/') || !path_or_name.ends_with(".yaml") => (t.to_string(), format!("built-in case {n}"), None),
+            Some((n, t)) if !path_or_name.contains('/') || !path_or_name.ends_with(".yaml") => {
+                (t.to_string(), format!("built-in case {n}"), None)
+            }
             _ => {
                 let names: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
                 return Err(ConfigError::Read {
@@ -178,24 +221,55 @@ pub fn load(path_or_name: &str, overrides: &[String]) -> Result<Loaded, ConfigEr
 }
 
 /// Parses configuration text (see [`load`]).
-pub fn from_str(text: &str, source_name: &str, base_dir: Option<PathBuf>, overrides: &[String]) -> Result<Loaded, ConfigError> {
+pub fn from_str(
+    text: &str,
+    source_name: &str,
+    base_dir: Option<PathBuf>,
+    overrides: &[String],
+) -> Result<Loaded, ConfigError> {
     let src = || source_name.to_string();
-    let doc: Value = serde_saphyr::from_str(text).map_err(|e| ConfigError::Yaml { source_name: src(), message: e.to_string() })?;
-    let mut params = ros_parameters(doc).map_err(|message| ConfigError::Layout { source_name: src(), message })?;
+    let doc: Value = serde_saphyr::from_str(text).map_err(|e| ConfigError::Yaml {
+        source_name: src(),
+        message: e.to_string(),
+    })?;
+    let mut params = ros_parameters(doc).map_err(|message| ConfigError::Layout {
+        source_name: src(),
+        message,
+    })?;
     for o in overrides {
-        apply_override(&mut params, o).map_err(|(key, message)| ConfigError::Key { source_name: src(), key, message })?;
+        apply_override(&mut params, o).map_err(|(key, message)| ConfigError::Key {
+            source_name: src(),
+            key,
+            message,
+        })?;
     }
     let config: RunConfig = serde_path_to_error::deserialize(params.clone()).map_err(|e| {
         let key = e.path().to_string();
-        ConfigError::Key { source_name: src(), key: if key == "." { "(top level)".into() } else { key }, message: e.into_inner().to_string() }
+        ConfigError::Key {
+            source_name: src(),
+            key: if key == "." {
+                "(top level)".into()
+            } else {
+                key
+            },
+            message: e.into_inner().to_string(),
+        }
     })?;
-    Ok(Loaded { config, source_name: source_name.to_string(), base_dir, parameters: params })
+    Ok(Loaded {
+        config,
+        source_name: source_name.to_string(),
+        base_dir,
+        parameters: params,
+    })
 }
 
 /// The `ros__parameters` map of the single node in a ROS 2 parameters file.
 fn ros_parameters(doc: Value) -> Result<Value, String> {
     let Value::Object(top) = doc else {
-        return Err("expected a map `<node name>: {ros__parameters: {...}}` (the ROS 2 parameters layout)".into());
+        return Err(
+            "expected a map `<node name>: {ros__parameters: {...}}` (the ROS 2 parameters layout)"
+                .into(),
+        );
     };
     if top.len() != 1 {
         let keys: Vec<&String> = top.keys().collect();
@@ -216,7 +290,10 @@ fn ros_parameters(doc: Value) -> Result<Value, String> {
 /// Applies `a.b.c=value` (value parsed as YAML) to the parameter tree.
 pub fn apply_override(params: &mut Value, o: &str) -> Result<(), (String, String)> {
     let Some((key, raw)) = o.split_once('=') else {
-        return Err((o.to_string(), "an override must look like key.sub=value (e.g. --set solver.cfl=0.15)".into()));
+        return Err((
+            o.to_string(),
+            "an override must look like key.sub=value (e.g. --set solver.cfl=0.15)".into(),
+        ));
     };
     let key = key.trim();
     if key.is_empty() || key.split('.').any(str::is_empty) {
@@ -225,25 +302,39 @@ pub fn apply_override(params: &mut Value, o: &str) -> Result<(), (String, String
     let value: Value = if raw.trim().is_empty() {
         Value::String(String::new())
     } else {
-        serde_saphyr::from_str(raw).map_err(|e| (key.to_string(), format!("value `{raw}` is not valid YAML: {e}")))?
+        serde_saphyr::from_str(raw).map_err(|e| {
+            (
+                key.to_string(),
+                format!("value `{raw}` is not valid YAML: {e}"),
+            )
+        })?
     };
     let mut node = params;
     let parts: Vec<&str> = key.split('.').collect();
     for (i, part) in parts.iter().enumerate() {
         let Value::Object(map) = node else {
-            return Err((key.to_string(), format!("`{}` is not a group of parameters", parts[..i].join("."))));
+            return Err((
+                key.to_string(),
+                format!("`{}` is not a group of parameters", parts[..i].join(".")),
+            ));
         };
         if i + 1 == parts.len() {
             map.insert(part.to_string(), value);
             return Ok(());
         }
-        node = map.entry(part.to_string()).or_insert_with(|| Value::Object(Map::new()));
+        node = map
+            .entry(part.to_string())
+            .or_insert_with(|| Value::Object(Map::new()));
     }
     unreachable!()
 }
 
 fn key_err(src: &str, key: &str, message: impl Into<String>) -> ConfigError {
-    ConfigError::Key { source_name: src.into(), key: key.into(), message: message.into() }
+    ConfigError::Key {
+        source_name: src.into(),
+        key: key.into(),
+        message: message.into(),
+    }
 }
 
 /// Six values per DOF, or none (all zero).
@@ -252,11 +343,19 @@ fn six(src: &str, key: &str, v: &[f64]) -> Result<[f64; 6], ConfigError> {
         0 => Ok([0.0; 6]),
         6 => {
             if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-                return Err(key_err(src, key, format!("element {i} is not a finite number")));
+                return Err(key_err(
+                    src,
+                    key,
+                    format!("element {i} is not a finite number"),
+                ));
             }
             Ok([v[0], v[1], v[2], v[3], v[4], v[5]])
         }
-        n => Err(key_err(src, key, format!("expected 6 values ({DOF_NAMES}), got {n}"))),
+        n => Err(key_err(
+            src,
+            key,
+            format!("expected 6 values ({DOF_NAMES}), got {n}"),
+        )),
     }
 }
 
@@ -269,16 +368,36 @@ impl Loaded {
         if c.probes.x.len() != n || !(c.probes.y.len() == n || c.probes.y.is_empty()) {
             return Err(key_err(src, "probes", format!("probes.names, probes.x and probes.y must have the same length (got {}, {}, {}); probes.y may be omitted in 2D", n, c.probes.x.len(), c.probes.y.len())));
         }
-        let probes = (0..n).map(|i| ProbeSpec { name: c.probes.names[i].clone(), x: c.probes.x[i], y: c.probes.y.get(i).copied().unwrap_or(0.0) }).collect();
+        let probes = (0..n)
+            .map(|i| ProbeSpec {
+                name: c.probes.names[i].clone(),
+                x: c.probes.x[i],
+                y: c.probes.y.get(i).copied().unwrap_or(0.0),
+            })
+            .collect();
         let s = &c.pressure_sensors;
         let n = s.names.len();
         if s.x.len() != n || s.z.len() != n || !(s.y.len() == n || s.y.is_empty()) {
             return Err(key_err(src, "pressure_sensors", format!("pressure_sensors.names, .x, .y and .z must have the same length (got {}, {}, {}, {}); .y may be omitted in 2D", n, s.x.len(), s.y.len(), s.z.len())));
         }
-        let sensors = (0..n).map(|i| SensorSpec { name: s.names[i].clone(), x: s.x[i], y: s.y.get(i).copied().unwrap_or(0.0), z: s.z[i] }).collect();
-        for (what, names) in [("probes.names", &c.probes.names), ("pressure_sensors.names", &s.names)] {
+        let sensors = (0..n)
+            .map(|i| SensorSpec {
+                name: s.names[i].clone(),
+                x: s.x[i],
+                y: s.y.get(i).copied().unwrap_or(0.0),
+                z: s.z[i],
+            })
+            .collect();
+        for (what, names) in [
+            ("probes.names", &c.probes.names),
+            ("pressure_sensors.names", &s.names),
+        ] {
             for (i, name) in names.iter().enumerate() {
-                if name.is_empty() || name.contains(',') || name.contains('"') || names[..i].contains(name) {
+                if name.is_empty()
+                    || name.contains(',')
+                    || name.contains('"')
+                    || names[..i].contains(name)
+                {
                     return Err(key_err(src, what, format!("`{name}` must be non-empty, unique and free of commas and quotes (it becomes a CSV column)")));
                 }
             }
@@ -286,7 +405,10 @@ impl Loaded {
         let p = SimParams {
             dimension: c.dimension,
             tank: c.tank.clone(),
-            fill: FillSpec { height: c.fill_height, length: c.fill_length },
+            fill: FillSpec {
+                height: c.fill_height,
+                length: c.fill_length,
+            },
             particle_spacing: c.particle_spacing,
             fluid: c.fluid.clone(),
             gravity: c.gravity,
@@ -294,12 +416,21 @@ impl Loaded {
             probes,
             pressure_sensors: sensors,
         };
-        p.validate().map_err(|e| key_err(src, &e.field, e.message))?;
+        p.validate()
+            .map_err(|e| key_err(src, &e.field, e.message))?;
         if !(c.output_rate_hz.is_finite() && c.output_rate_hz > 0.0) {
-            return Err(key_err(src, "output_rate_hz", format!("must be a positive number, got {}", c.output_rate_hz)));
+            return Err(key_err(
+                src,
+                "output_rate_hz",
+                format!("must be a positive number, got {}", c.output_rate_hz),
+            ));
         }
         if !(c.duration.is_finite() && c.duration > 0.0) {
-            return Err(key_err(src, "duration", format!("must be a positive number of seconds, got {}", c.duration)));
+            return Err(key_err(
+                src,
+                "duration",
+                format!("must be a positive number of seconds, got {}", c.duration),
+            ));
         }
         Ok(p)
     }
@@ -314,9 +445,17 @@ impl Loaded {
         let mut out = [RegularDof::default(); 6];
         for i in 0..6 {
             if a[i] != 0.0 && t[i] <= 0.0 {
-                return Err(key_err(src, "motion.regular.period", format!("element {i} must be positive where the amplitude is not zero")));
+                return Err(key_err(
+                    src,
+                    "motion.regular.period",
+                    format!("element {i} must be positive where the amplitude is not zero"),
+                ));
             }
-            out[i] = RegularDof { amplitude: a[i], period: t[i], phase: ph[i] };
+            out[i] = RegularDof {
+                amplitude: a[i],
+                period: t[i],
+                phase: ph[i],
+            };
         }
         Ok(out)
     }
@@ -325,20 +464,39 @@ impl Loaded {
     pub fn irregular(&self) -> Result<[JonswapDof; 6], ConfigError> {
         let r = &self.config.motion.irregular;
         let src = &self.source_name;
-        let a = six(src, "motion.irregular.significant_amplitude", &r.significant_amplitude)?;
+        let a = six(
+            src,
+            "motion.irregular.significant_amplitude",
+            &r.significant_amplitude,
+        )?;
         let t = six(src, "motion.irregular.peak_period", &r.peak_period)?;
         let mut out = [JonswapDof::default(); 6];
         for i in 0..6 {
             if a[i] != 0.0 && t[i] <= 0.0 {
-                return Err(key_err(src, "motion.irregular.peak_period", format!("element {i} must be positive where the amplitude is not zero")));
+                return Err(key_err(
+                    src,
+                    "motion.irregular.peak_period",
+                    format!("element {i} must be positive where the amplitude is not zero"),
+                ));
             }
-            out[i] = JonswapDof { significant_amplitude: a[i], peak_period: t[i] };
+            out[i] = JonswapDof {
+                significant_amplitude: a[i],
+                peak_period: t[i],
+            };
         }
         if !(r.gamma >= 1.0) {
-            return Err(key_err(src, "motion.irregular.gamma", format!("must be at least 1, got {}", r.gamma)));
+            return Err(key_err(
+                src,
+                "motion.irregular.gamma",
+                format!("must be at least 1, got {}", r.gamma),
+            ));
         }
         if r.components == 0 {
-            return Err(key_err(src, "motion.irregular.components", "must be at least 1"));
+            return Err(key_err(
+                src,
+                "motion.irregular.components",
+                "must be at least 1",
+            ));
         }
         Ok(out)
     }
@@ -347,7 +505,11 @@ impl Loaded {
     pub fn motion_file(&self) -> Result<PathBuf, ConfigError> {
         let f = &self.config.motion.file;
         if f.is_empty() {
-            return Err(key_err(&self.source_name, "motion.file", "motion.source is csv: name a CSV file with header time,x,y,z,roll,pitch,yaw"));
+            return Err(key_err(
+                &self.source_name,
+                "motion.file",
+                "motion.source is csv: name a CSV file with header time,x,y,z,roll,pitch,yaw",
+            ));
         }
         let p = PathBuf::from(f);
         Ok(match (&self.base_dir, p.is_relative()) {
@@ -390,7 +552,10 @@ mod tests {
     #[test]
     fn unknown_key_is_named_with_accepted_ones() {
         let e = err(&format!("{MIN}    solver: {{kernal: wendland}}\n"), &[]);
-        assert!(e.contains("case.yaml: solver.kernal: unknown field `kernal`, expected one of"), "{e}");
+        assert!(
+            e.contains("case.yaml: solver.kernal: unknown field `kernal`, expected one of"),
+            "{e}"
+        );
         assert!(e.contains("`kernel`"), "{e}");
         let e = err(MIN, &["tank.lenght=1.0"]);
         assert!(e.contains("tank.lenght: unknown field `lenght`"), "{e}");
@@ -399,14 +564,24 @@ mod tests {
     #[test]
     fn bad_enum_value_lists_the_choices() {
         let e = err(MIN, &["solver.kernel=gauss"]);
-        assert!(e.contains("solver.kernel: unknown variant `gauss`, expected `cubic_spline` or `wendland`"), "{e}");
+        assert!(
+            e.contains(
+                "solver.kernel: unknown variant `gauss`, expected `cubic_spline` or `wendland`"
+            ),
+            "{e}"
+        );
         let e = err(MIN, &["motion.source=bag"]);
         assert!(e.contains("motion.source") && e.contains("`csv`"), "{e}");
     }
 
     #[test]
     fn overrides_are_parsed_as_yaml() {
-        let o = vec!["probes.names=[a, b]".to_string(), "probes.x=[-0.375,0.0]".to_string(), "solver.cfl=0.1".to_string(), "dimension=3".into()];
+        let o = vec![
+            "probes.names=[a, b]".to_string(),
+            "probes.x=[-0.375,0.0]".to_string(),
+            "solver.cfl=0.1".to_string(),
+            "dimension=3".into(),
+        ];
         let l = from_str(MIN, "case.yaml", None, &o).unwrap();
         let p = l.sim_params().unwrap();
         assert_eq!(p.probes.len(), 2);
@@ -418,21 +593,42 @@ mod tests {
     #[test]
     fn wrong_types_and_values_name_the_key() {
         assert!(err(MIN, &["particle_spacing=fine"]).contains("particle_spacing: invalid type"));
-        assert!(err(MIN, &["fill_height=0.7"]).contains("fill_height: 0.7 m is above the tank height"));
-        assert!(err(MIN, &["probes.names=[a]"]).contains("probes: probes.names, probes.x and probes.y must have the same length"));
-        assert!(err(MIN, &["output_rate_hz=0"]).contains("output_rate_hz: must be a positive number"));
+        assert!(
+            err(MIN, &["fill_height=0.7"]).contains("fill_height: 0.7 m is above the tank height")
+        );
+        assert!(err(MIN, &["probes.names=[a]"])
+            .contains("probes: probes.names, probes.x and probes.y must have the same length"));
+        assert!(
+            err(MIN, &["output_rate_hz=0"]).contains("output_rate_hz: must be a positive number")
+        );
         assert!(err(MIN, &["tank.length=-1"]).contains("tank.length: must be a positive number"));
         assert!(err(MIN, &["solver"]).contains("an override must look like key.sub=value"));
         assert!(err("slosh: {}\n", &[]).contains("missing `ros__parameters:`"));
-        assert!(err("a: {ros__parameters: {}}\nb: {ros__parameters: {}}\n", &[]).contains("exactly one node name"));
-        assert!(err("slosh:\n  ros__parameters:\n    dimension: [\n", &[]).contains("not valid YAML"));
+        assert!(
+            err("a: {ros__parameters: {}}\nb: {ros__parameters: {}}\n", &[])
+                .contains("exactly one node name")
+        );
+        assert!(
+            err("slosh:\n  ros__parameters:\n    dimension: [\n", &[]).contains("not valid YAML")
+        );
     }
 
     #[test]
     fn motion_arrays_need_six_values() {
-        let l = from_str(MIN, "case.yaml", None, &["motion.regular.amplitude=[0.1, 0.2]".into()]).unwrap();
+        let l = from_str(
+            MIN,
+            "case.yaml",
+            None,
+            &["motion.regular.amplitude=[0.1, 0.2]".into()],
+        )
+        .unwrap();
         let e = l.regular().unwrap_err().to_string();
-        assert!(e.contains("motion.regular.amplitude: expected 6 values (x, y, z, roll, pitch, yaw), got 2"), "{e}");
+        assert!(
+            e.contains(
+                "motion.regular.amplitude: expected 6 values (x, y, z, roll, pitch, yaw), got 2"
+            ),
+            "{e}"
+        );
     }
 
     #[test]

@@ -44,18 +44,38 @@ enum Command {
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
-        Command::Run { config: cfg, out, duration, set } => {
+        Command::Run {
+            config: cfg,
+            out,
+            duration,
+            set,
+        } => {
             let loaded = config::load(&cfg, &set)?;
-            eprintln!("slosh: running {} for {} s, writing to {}", loaded.source_name, duration.unwrap_or(loaded.config.duration), out.display());
-            let opts = runner::RunOptions { duration, progress: true };
+            eprintln!(
+                "slosh: running {} for {} s, writing to {}",
+                loaded.source_name,
+                duration.unwrap_or(loaded.config.duration),
+                out.display()
+            );
+            let opts = runner::RunOptions {
+                duration,
+                progress: true,
+            };
             let s = runner::run(&loaded, &out, &opts)?;
             println!(
                 "done: {} s simulated in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s, {} liquid + {} boundary particles, {} lost)",
                 s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s, s.particles_fluid, s.particles_boundary, s.particles_lost
             );
-            println!("outputs: {}/{{probes.csv, wrench.csv, pressure.csv, summary.json}}", out.display());
+            println!(
+                "outputs: {}/{{probes.csv, wrench.csv, pressure.csv, summary.json}}",
+                out.display()
+            );
         }
-        Command::Bench { case, duration, json } => {
+        Command::Bench {
+            case,
+            duration,
+            json,
+        } => {
             let cases: Vec<&bench::Case> = if case.is_empty() {
                 bench::CASES.iter().collect()
             } else {
@@ -64,7 +84,18 @@ fn main() -> anyhow::Result<()> {
                     .collect::<anyhow::Result<_>>()?
             };
             if !json {
-                println!("{:<16} {:>7} {:>9} {:>8} {:>8} {:>10} {:>14} {:>10} {:>12}", "case", "threads", "particles", "steps", "sim s", "wall s", "particle-st/s", "RT factor", "wall s/sim s");
+                println!(
+                    "{:<16} {:>7} {:>9} {:>8} {:>8} {:>10} {:>14} {:>10} {:>12}",
+                    "case",
+                    "threads",
+                    "particles",
+                    "steps",
+                    "sim s",
+                    "wall s",
+                    "particle-st/s",
+                    "RT factor",
+                    "wall s/sim s"
+                );
             }
             for c in cases {
                 let r = bench::run_case(c, duration)?;
@@ -73,7 +104,15 @@ fn main() -> anyhow::Result<()> {
                 } else {
                     println!(
                         "{:<16} {:>7} {:>9} {:>8} {:>8.3} {:>10.2} {:>14.3e} {:>10.4} {:>12.1}",
-                        r.case, r.threads, r.particles_fluid, r.steps, r.sim_time_s, r.wall_time_s, r.particle_steps_per_s, r.realtime_factor, r.wall_s_per_sim_s
+                        r.case,
+                        r.threads,
+                        r.particles_fluid,
+                        r.steps,
+                        r.sim_time_s,
+                        r.wall_time_s,
+                        r.particle_steps_per_s,
+                        r.realtime_factor,
+                        r.wall_s_per_sim_s
                     );
                 }
             }

@@ -16,7 +16,10 @@ pub struct CsvOutputs {
 
 fn create(dir: &Path, name: &str, header: &str) -> std::io::Result<BufWriter<File>> {
     let path = dir.join(name);
-    let mut w = BufWriter::new(File::create(&path).map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?);
+    let mut w = BufWriter::new(
+        File::create(&path)
+            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?,
+    );
     writeln!(w, "{header}")?;
     Ok(w)
 }
@@ -24,12 +27,32 @@ fn create(dir: &Path, name: &str, header: &str) -> std::io::Result<BufWriter<Fil
 impl CsvOutputs {
     /// Creates the folder and the three CSV files with their headers.
     pub fn create(dir: &Path, params: &SimParams) -> std::io::Result<Self> {
-        std::fs::create_dir_all(dir).map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
-        let names = |v: Vec<&str>| std::iter::once("time").chain(v).collect::<Vec<_>>().join(",");
+        std::fs::create_dir_all(dir)
+            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
+        let names = |v: Vec<&str>| {
+            std::iter::once("time")
+                .chain(v)
+                .collect::<Vec<_>>()
+                .join(",")
+        };
         Ok(Self {
-            probes: create(dir, "probes.csv", &names(params.probes.iter().map(|p| p.name.as_str()).collect()))?,
+            probes: create(
+                dir,
+                "probes.csv",
+                &names(params.probes.iter().map(|p| p.name.as_str()).collect()),
+            )?,
             wrench: create(dir, "wrench.csv", "time,fx,fy,fz,mx,my,mz")?,
-            pressure: create(dir, "pressure.csv", &names(params.pressure_sensors.iter().map(|p| p.name.as_str()).collect()))?,
+            pressure: create(
+                dir,
+                "pressure.csv",
+                &names(
+                    params
+                        .pressure_sensors
+                        .iter()
+                        .map(|p| p.name.as_str())
+                        .collect(),
+                ),
+            )?,
             dir: dir.to_path_buf(),
         })
     }
@@ -40,15 +63,19 @@ impl CsvOutputs {
 
     /// Appends one row to each file.
     pub fn write(&mut self, o: &Observation) -> std::io::Result<()> {
-        let row = |w: &mut BufWriter<File>, vals: &mut dyn Iterator<Item = f64>| -> std::io::Result<()> {
-            write!(w, "{:.6}", o.time)?;
-            for v in vals {
-                write!(w, ",{v:.6e}")?;
-            }
-            writeln!(w)
-        };
+        let row =
+            |w: &mut BufWriter<File>, vals: &mut dyn Iterator<Item = f64>| -> std::io::Result<()> {
+                write!(w, "{:.6}", o.time)?;
+                for v in vals {
+                    write!(w, ",{v:.6e}")?;
+                }
+                writeln!(w)
+            };
         row(&mut self.probes, &mut o.probes.iter().copied())?;
-        row(&mut self.wrench, &mut o.wrench.force.iter().chain(o.wrench.moment.iter()).copied())?;
+        row(
+            &mut self.wrench,
+            &mut o.wrench.force.iter().chain(o.wrench.moment.iter()).copied(),
+        )?;
         row(&mut self.pressure, &mut o.pressures.iter().copied())?;
         Ok(())
     }

@@ -19,7 +19,11 @@ pub enum RunError {
     #[error("{0}")]
     Output(#[from] std::io::Error),
     #[error("solver stopped: {error} (outputs up to t = {time:.4} s are in {dir})")]
-    Solver { error: sph::SimError, time: f64, dir: String },
+    Solver {
+        error: sph::SimError,
+        time: f64,
+        dir: String,
+    },
 }
 
 /// Options of one run.
@@ -37,7 +41,12 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
     let motion = motion_source::build(cfg)?;
     let duration = opts.duration.unwrap_or(cfg.config.duration);
     if !(duration.is_finite() && duration > 0.0) {
-        return Err(crate::config::ConfigError::Key { source_name: "--duration".into(), key: "duration".into(), message: format!("must be a positive number of seconds, got {duration}") }.into());
+        return Err(crate::config::ConfigError::Key {
+            source_name: "--duration".into(),
+            key: "duration".into(),
+            message: format!("must be a positive number of seconds, got {duration}"),
+        }
+        .into());
     }
     if duration > motion.end_time() {
         return Err(crate::config::ConfigError::Key {
@@ -48,10 +57,21 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
         .into());
     }
     let mut outputs = CsvOutputs::create(out, &params)?;
-    let mut sim = sph::build(params.clone()).map_err(|e| RunError::Solver { error: e, time: 0.0, dir: out.display().to_string() })?;
+    let mut sim = sph::build(params.clone()).map_err(|e| RunError::Solver {
+        error: e,
+        time: 0.0,
+        dir: out.display().to_string(),
+    })?;
     let bar = progress_bar(opts.progress, duration);
     let start = Instant::now();
-    let result = run_loop(sim.as_mut(), motion.as_ref(), &mut outputs, duration, cfg.config.output_rate_hz, &bar);
+    let result = run_loop(
+        sim.as_mut(),
+        motion.as_ref(),
+        &mut outputs,
+        duration,
+        cfg.config.output_rate_hz,
+        &bar,
+    );
     let wall = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     outputs.flush()?;
@@ -67,7 +87,11 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
         wall_time_s: wall,
         realtime_factor: sim.time() / wall,
         particle_steps_per_s: stats.steps as f64 * counts.fluid as f64 / wall,
-        min_dt_s: if stats.min_dt.is_finite() { stats.min_dt } else { 0.0 },
+        min_dt_s: if stats.min_dt.is_finite() {
+            stats.min_dt
+        } else {
+            0.0
+        },
         liquid_mass_kg: sim.liquid_mass(),
         error: result.as_ref().err().map(|e| e.to_string()),
         parameters: cfg.parameters.clone(),
@@ -75,7 +99,11 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
     write_summary(out, &summary)?;
     match result {
         Ok(()) => Ok(summary),
-        Err(LoopError::Solver(error)) => Err(RunError::Solver { error, time: sim.time(), dir: out.display().to_string() }),
+        Err(LoopError::Solver(error)) => Err(RunError::Solver {
+            error,
+            time: sim.time(),
+            dir: out.display().to_string(),
+        }),
         Err(LoopError::Io(e)) => Err(e.into()),
     }
 }
@@ -88,7 +116,14 @@ enum LoopError {
     Io(std::io::Error),
 }
 
-fn run_loop(sim: &mut dyn Solver, motion: &dyn TankMotion, out: &mut CsvOutputs, duration: f64, rate: f64, bar: &ProgressBar) -> Result<(), LoopError> {
+fn run_loop(
+    sim: &mut dyn Solver,
+    motion: &dyn TankMotion,
+    out: &mut CsvOutputs,
+    duration: f64,
+    rate: f64,
+    bar: &ProgressBar,
+) -> Result<(), LoopError> {
     let mut k = 0u64;
     let start = Instant::now();
     let mut last_draw = Instant::now();

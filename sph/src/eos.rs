@@ -11,7 +11,11 @@ impl Tait {
     pub const GAMMA: f32 = 7.0;
 
     pub fn new(rho0: f64, c0: f64) -> Self {
-        Self { rho0: rho0 as f32, b: (c0 * c0 * rho0 / 7.0) as f32, c0: c0 as f32 }
+        Self {
+            rho0: rho0 as f32,
+            b: (c0 * c0 * rho0 / 7.0) as f32,
+            c0: c0 as f32,
+        }
     }
 
     #[inline(always)]

@@ -9,7 +9,11 @@
 use crate::particles::{Boundary, Fluid};
 
 /// Saves the state at the start of a symplectic step and advances it half a step.
-pub fn symplectic_predict<const D: usize>(f: &mut Fluid<D>, walls: Option<&mut Boundary<D>>, dt: f64) {
+pub fn symplectic_predict<const D: usize>(
+    f: &mut Fluid<D>,
+    walls: Option<&mut Boundary<D>>,
+    dt: f64,
+) {
     let h = 0.5 * dt;
     for d in 0..D {
         f.pos0[d].copy_from_slice(&f.pos[d]);
@@ -32,7 +36,11 @@ pub fn symplectic_predict<const D: usize>(f: &mut Fluid<D>, walls: Option<&mut B
 }
 
 /// Completes a symplectic step from the rates at the half step.
-pub fn symplectic_correct<const D: usize>(f: &mut Fluid<D>, walls: Option<&mut Boundary<D>>, dt: f64) {
+pub fn symplectic_correct<const D: usize>(
+    f: &mut Fluid<D>,
+    walls: Option<&mut Boundary<D>>,
+    dt: f64,
+) {
     for d in 0..D {
         for i in 0..f.len() {
             let v0 = f.vel0[d][i];
@@ -56,8 +64,17 @@ pub fn symplectic_correct<const D: usize>(f: &mut Fluid<D>, walls: Option<&mut B
 }
 
 /// One Verlet step; `euler` selects the first-order restart step.
-pub fn verlet<const D: usize>(f: &mut Fluid<D>, walls: Option<&mut Boundary<D>>, dt: f64, euler: bool) {
-    let (w_prev, w_now, gain) = if euler { (0.0, 1.0, dt) } else { (1.0, 0.0, 2.0 * dt) };
+pub fn verlet<const D: usize>(
+    f: &mut Fluid<D>,
+    walls: Option<&mut Boundary<D>>,
+    dt: f64,
+    euler: bool,
+) {
+    let (w_prev, w_now, gain) = if euler {
+        (0.0, 1.0, dt)
+    } else {
+        (1.0, 0.0, 2.0 * dt)
+    };
     for d in 0..D {
         for i in 0..f.len() {
             let v = f.vel[d][i];

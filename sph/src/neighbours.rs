@@ -1,13 +1,21 @@
 //! Cell lists: a fixed grid over the tank (the tank frame does not move, so neither does the grid), particles
 //! kept sorted by cell with a stable counting sort, and the contiguous index ranges that hold a cell's
-//! neighbours. Cells are as wide as the kernel support, x varies fastest, so the 3 cells of a row are one range.
+//! neighbours. Cells are half the kernel support wide and a particle's neighbours lie within two cells, so a
+//! search scans 5 cells per row (50 % of the scanned area in reach in 2D, against 35 % with support-wide
+//! cells); x varies fastest, so the 5 cells of a row are one contiguous range.
 //! [`naive_pairs`] is the O(N²) reference the tests hold the grid to.
 
 /// Marks a particle outside the grid.
 pub const OUTSIDE: u32 = u32::MAX;
 
-/// At most 3^(D−1) ranges per cell: 3 in 2D, 9 in 3D.
-pub type Ranges = [(u32, u32); 9];
+/// How many cells away a neighbour can be.
+const REACH: i64 = 2;
+
+/// At most (2·REACH + 1)^(D−1) ranges per cell: 5 in 2D, 25 in 3D.
+pub type Ranges = [(u32, u32); 25];
+
+/// An empty [`Ranges`].
+pub const NO_RANGES: Ranges = [(0, 0); 25];
 
 #[derive(Clone, Debug)]
 pub struct Grid<const D: usize> {
@@ -18,13 +26,19 @@ pub struct Grid<const D: usize> {
 }
 
 impl<const D: usize> Grid<D> {
-    /// Grid covering the box [lo, hi] with cells at least `cell` wide.
+    /// Grid covering the box [lo, hi] with cells `cell` wide; neighbours are searched within 2 cells, so
+    /// `cell` must be at least half the search radius.
     pub fn new(lo: [f64; D], hi: [f64; D], cell: f64) -> Self {
         let mut dims = [0; D];
         for k in 0..D {
             dims[k] = (((hi[k] - lo[k]) / cell).ceil() as usize).max(1);
         }
-        Self { origin: lo, inv_cell: 1.0 / cell, cell, dims }
+        Self {
+            origin: lo,
+            inv_cell: 1.0 / cell,
+            cell,
+            dims,
+        }
     }
 
     pub fn dims(&self) -> [usize; D] {
@@ -91,21 +105,22 @@ impl<const D: usize> Grid<D> {
     #[inline]
     fn ranges_at(&self, c: [i64; D], starts: &[u32], out: &mut Ranges) -> usize {
         let nx = self.dims[0] as i64;
-        let x0 = (c[0] - 1).max(0);
-        let x1 = (c[0] + 1).min(nx - 1);
+        let x0 = (c[0] - REACH).max(0);
+        let x1 = (c[0] + REACH).min(nx - 1);
         if x0 > x1 {
             return 0;
         }
         let mut n = 0;
-        // Iterate over the 3^(D-1) rows around c in the higher dimensions.
-        let rows = 3usize.pow(D as u32 - 1);
+        // Iterate over the rows around c in the higher dimensions.
+        let side = 2 * REACH as usize + 1;
+        let rows = side.pow(D as u32 - 1);
         'rows: for r in 0..rows {
             let mut rest = r;
             let mut base = 0i64;
             let mut stride = nx;
             for k in 1..D {
-                let ck = c[k] + (rest % 3) as i64 - 1;
-                rest /= 3;
+                let ck = c[k] + (rest % side) as i64 - REACH;
+                rest /= side;
                 if ck < 0 || ck >= self.dims[k] as i64 {
                     continue 'rows;
                 }
@@ -133,7 +148,7 @@ impl<const D: usize> Grid<D> {
     pub fn ranges_around(&self, p: [f64; D], starts: &[u32], out: &mut Ranges) -> usize {
         let c = self.coords_of(p);
         for k in 0..D {
-            if c[k] < -1 || c[k] > self.dims[k] as i64 {
+            if c[k] < -REACH || c[k] >= self.dims[k] as i64 + REACH {
                 return 0;
             }
         }
@@ -144,7 +159,12 @@ impl<const D: usize> Grid<D> {
 /// Stable counting sort by cell. `cells[i]` is particle i's cell or [`OUTSIDE`]. Fills `starts` (n_cells + 1
 /// offsets) and `dest[i]`, the sorted position of particle i; particles outside go after all others, in order.
 /// Returns the number of particles inside the grid.
-pub fn counting_sort(n_cells: usize, cells: &[u32], starts: &mut Vec<u32>, dest: &mut Vec<u32>) -> usize {
+pub fn counting_sort(
+    n_cells: usize,
+    cells: &[u32],
+    starts: &mut Vec<u32>,
+    dest: &mut Vec<u32>,
+) -> usize {
     starts.clear();
     starts.resize(n_cells + 2, 0);
     for &c in cells {
@@ -196,7 +216,11 @@ pub fn naive_pairs<const D: usize>(pos: &[[f64; D]], radius: f64) -> Vec<(usize,
 }
 
 /// The same pairs found through the grid (positions are sorted internally; returned with original indices).
-pub fn grid_pairs<const D: usize>(grid: &Grid<D>, pos: &[[f64; D]], radius: f64) -> Vec<(usize, usize)> {
+pub fn grid_pairs<const D: usize>(
+    grid: &Grid<D>,
+    pos: &[[f64; D]],
+    radius: f64,
+) -> Vec<(usize, usize)> {
     let cells: Vec<u32> = pos.iter().map(|p| grid.cell_of(*p)).collect();
     let (mut starts, mut dest) = (Vec::new(), Vec::new());
     let inside = counting_sort(grid.n_cells(), &cells, &mut starts, &mut dest);
@@ -205,7 +229,7 @@ pub fn grid_pairs<const D: usize>(grid: &Grid<D>, pos: &[[f64; D]], radius: f64)
         order[d as usize] = i;
     }
     let mut out = Vec::new();
-    let mut ranges = [(0, 0); 9];
+    let mut ranges = NO_RANGES;
     for (i, p) in pos.iter().enumerate() {
         if cells[i] == OUTSIDE {
             continue;
@@ -232,15 +256,19 @@ mod tests {
     fn random_points<const D: usize>(n: usize, seed: u64, lo: f64, hi: f64) -> Vec<[f64; D]> {
         let mut s = seed;
         let mut next = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
-        (0..n).map(|_| std::array::from_fn(|_| lo + (hi - lo) * next())).collect()
+        (0..n)
+            .map(|_| std::array::from_fn(|_| lo + (hi - lo) * next()))
+            .collect()
     }
 
     fn check<const D: usize>() {
         let radius = 0.07;
-        let grid = Grid::<D>::new([0.0; D], [1.0; D], radius);
+        let grid = Grid::<D>::new([0.0; D], [1.0; D], radius / 2.0);
         let pos = random_points::<D>(if D == 2 { 2000 } else { 3000 }, 42 + D as u64, 0.0, 0.999);
         let mut a = naive_pairs(&pos, radius);
         let mut b = grid_pairs(&grid, &pos, radius);
@@ -267,6 +295,12 @@ mod tests {
         assert_eq!(g.cell_of([0.5, 1.01]), OUTSIDE);
         assert_eq!(g.cell_of([f64::NAN, 0.5]), OUTSIDE);
         assert_eq!(g.cell_of([0.05, 0.15]), 10);
+        // A point's ranges: its own cell and two on each side; far off the grid, nothing.
+        let mut r = NO_RANGES;
+        assert_eq!(
+            g.ranges_around([5.0, 5.0], &vec![0; g.n_cells() + 1], &mut r),
+            0
+        );
         let cells = vec![3, OUTSIDE, 1, 3];
         let (mut s, mut d) = (Vec::new(), Vec::new());
         assert_eq!(counting_sort(g.n_cells(), &cells, &mut s, &mut d), 3);

@@ -29,7 +29,10 @@ pub struct FluidSpec {
 
 impl Default for FluidSpec {
     fn default() -> Self {
-        Self { density: 1000.0, kinematic_viscosity: 1.0e-6 }
+        Self {
+            density: 1000.0,
+            kinematic_viscosity: 1.0e-6,
+        }
     }
 }
 
@@ -88,7 +91,12 @@ pub struct ArtificialViscosity {
 
 impl Default for ArtificialViscosity {
     fn default() -> Self {
-        Self { alpha: 0.02, beta: 0.0, eta_factor: 0.01, boundary_factor: 0.0 }
+        Self {
+            alpha: 0.02,
+            beta: 0.0,
+            eta_factor: 0.01,
+            boundary_factor: 0.0,
+        }
     }
 }
 
@@ -102,7 +110,10 @@ pub struct DensityDiffusion {
 
 impl Default for DensityDiffusion {
     fn default() -> Self {
-        Self { kind: DiffusionKind::Fourtakas, delta: 0.1 }
+        Self {
+            kind: DiffusionKind::Fourtakas,
+            delta: 0.1,
+        }
     }
 }
 
@@ -117,7 +128,10 @@ pub struct BoundarySpec {
 
 impl Default for BoundarySpec {
     fn default() -> Self {
-        Self { method: BoundaryMethod::Dynamic, layers: 0 }
+        Self {
+            method: BoundaryMethod::Dynamic,
+            layers: 0,
+        }
     }
 }
 
@@ -224,7 +238,10 @@ pub struct ParamError {
 }
 
 fn err(field: &str, message: impl Into<String>) -> ParamError {
-    ParamError { field: field.to_string(), message: message.into() }
+    ParamError {
+        field: field.to_string(),
+        message: message.into(),
+    }
 }
 
 fn positive(field: &str, v: f64) -> Result<(), ParamError> {
@@ -263,7 +280,11 @@ impl SimParams {
         if self.solver.sound_speed > 0.0 {
             return self.solver.sound_speed;
         }
-        let href = if self.solver.reference_height > 0.0 { self.solver.reference_height } else { self.fill.height };
+        let href = if self.solver.reference_height > 0.0 {
+            self.solver.reference_height
+        } else {
+            self.fill.height
+        };
         self.solver.sound_speed_coefficient * (self.gravity * href).sqrt()
     }
 
@@ -279,7 +300,10 @@ impl SimParams {
     /// Checks every field; the error names the first unusable one.
     pub fn validate(&self) -> Result<(), ParamError> {
         if self.dimension != 2 && self.dimension != 3 {
-            return Err(err("dimension", format!("must be 2 or 3, got {}", self.dimension)));
+            return Err(err(
+                "dimension",
+                format!("must be 2 or 3, got {}", self.dimension),
+            ));
         }
         positive("tank.length", self.tank.length)?;
         positive("tank.breadth", self.tank.breadth)?;
@@ -292,32 +316,77 @@ impl SimParams {
         non_negative("gravity", self.gravity)?;
         let dp = self.particle_spacing;
         if self.fill.height > self.tank.height {
-            return Err(err("fill_height", format!("{} m is above the tank height {} m", self.fill.height, self.tank.height)));
+            return Err(err(
+                "fill_height",
+                format!(
+                    "{} m is above the tank height {} m",
+                    self.fill.height, self.tank.height
+                ),
+            ));
         }
         if self.fill.length > self.tank.length {
-            return Err(err("fill_length", format!("{} m is longer than the tank ({} m)", self.fill.length, self.tank.length)));
+            return Err(err(
+                "fill_length",
+                format!(
+                    "{} m is longer than the tank ({} m)",
+                    self.fill.length, self.tank.length
+                ),
+            ));
         }
-        let min_extent = if self.dimension == 3 { self.tank.breadth.min(self.tank.length) } else { self.tank.length };
+        let min_extent = if self.dimension == 3 {
+            self.tank.breadth.min(self.tank.length)
+        } else {
+            self.tank.length
+        };
         if min_extent < 4.0 * dp || self.tank.height < 4.0 * dp {
-            return Err(err("particle_spacing", format!("{dp} m is too coarse for the tank: use at most a quarter of its smallest side")));
+            return Err(err(
+                "particle_spacing",
+                format!(
+                    "{dp} m is too coarse for the tank: use at most a quarter of its smallest side"
+                ),
+            ));
         }
         if self.fill.height < 2.0 * dp {
-            return Err(err("fill_height", format!("{} m is less than two particle spacings ({dp} m)", self.fill.height)));
+            return Err(err(
+                "fill_height",
+                format!(
+                    "{} m is less than two particle spacings ({dp} m)",
+                    self.fill.height
+                ),
+            ));
         }
         let s = &self.solver;
         if !(s.smoothing_ratio >= 0.9 && s.smoothing_ratio <= 3.0) {
-            return Err(err("solver.smoothing_ratio", format!("h/dp must be within 0.9..3, got {}", s.smoothing_ratio)));
+            return Err(err(
+                "solver.smoothing_ratio",
+                format!("h/dp must be within 0.9..3, got {}", s.smoothing_ratio),
+            ));
         }
         if !(s.cfl > 0.0 && s.cfl <= 1.0) {
-            return Err(err("solver.cfl", format!("must be within (0, 1], got {}", s.cfl)));
+            return Err(err(
+                "solver.cfl",
+                format!("must be within (0, 1], got {}", s.cfl),
+            ));
         }
         positive("solver.sound_speed_coefficient", s.sound_speed_coefficient)?;
         non_negative("solver.reference_height", s.reference_height)?;
         non_negative("solver.sound_speed", s.sound_speed)?;
-        non_negative("solver.artificial_viscosity.alpha", s.artificial_viscosity.alpha)?;
-        non_negative("solver.artificial_viscosity.beta", s.artificial_viscosity.beta)?;
-        positive("solver.artificial_viscosity.eta_factor", s.artificial_viscosity.eta_factor)?;
-        non_negative("solver.artificial_viscosity.boundary_factor", s.artificial_viscosity.boundary_factor)?;
+        non_negative(
+            "solver.artificial_viscosity.alpha",
+            s.artificial_viscosity.alpha,
+        )?;
+        non_negative(
+            "solver.artificial_viscosity.beta",
+            s.artificial_viscosity.beta,
+        )?;
+        positive(
+            "solver.artificial_viscosity.eta_factor",
+            s.artificial_viscosity.eta_factor,
+        )?;
+        non_negative(
+            "solver.artificial_viscosity.boundary_factor",
+            s.artificial_viscosity.boundary_factor,
+        )?;
         non_negative("solver.density_diffusion.delta", s.density_diffusion.delta)?;
         non_negative("solver.dt_min", s.dt_min)?;
         positive("solver.dt_max", s.dt_max)?;
@@ -325,30 +394,66 @@ impl SimParams {
             return Err(err("solver.verlet_reset_steps", "must be at least 1"));
         }
         if s.laminar_viscosity && self.fluid.kinematic_viscosity <= 0.0 {
-            return Err(err("fluid.kinematic_viscosity", "must be positive when solver.laminar_viscosity is on"));
+            return Err(err(
+                "fluid.kinematic_viscosity",
+                "must be positive when solver.laminar_viscosity is on",
+            ));
         }
         if self.gravity == 0.0 && s.sound_speed <= 0.0 {
-            return Err(err("solver.sound_speed", "set an explicit sound speed when gravity is 0"));
+            return Err(err(
+                "solver.sound_speed",
+                "set an explicit sound speed when gravity is 0",
+            ));
         }
         let (hl, hb) = (self.tank.length / 2.0, self.tank.breadth / 2.0);
         for (i, p) in self.probes.iter().enumerate() {
             if !(p.x.abs() < hl) {
-                return Err(err("probes.x", format!("probe {i} ({}) at x = {} m is outside the tank (|x| < {hl})", p.name, p.x)));
+                return Err(err(
+                    "probes.x",
+                    format!(
+                        "probe {i} ({}) at x = {} m is outside the tank (|x| < {hl})",
+                        p.name, p.x
+                    ),
+                ));
             }
             if self.dimension == 3 && !(p.y.abs() < hb) {
-                return Err(err("probes.y", format!("probe {i} ({}) at y = {} m is outside the tank (|y| < {hb})", p.name, p.y)));
+                return Err(err(
+                    "probes.y",
+                    format!(
+                        "probe {i} ({}) at y = {} m is outside the tank (|y| < {hb})",
+                        p.name, p.y
+                    ),
+                ));
             }
         }
         for (i, p) in self.pressure_sensors.iter().enumerate() {
             let tol = 1e-9;
             if !(p.x.abs() <= hl + tol) {
-                return Err(err("pressure_sensors.x", format!("sensor {i} ({}) at x = {} m is outside the tank", p.name, p.x)));
+                return Err(err(
+                    "pressure_sensors.x",
+                    format!(
+                        "sensor {i} ({}) at x = {} m is outside the tank",
+                        p.name, p.x
+                    ),
+                ));
             }
             if self.dimension == 3 && !(p.y.abs() <= hb + tol) {
-                return Err(err("pressure_sensors.y", format!("sensor {i} ({}) at y = {} m is outside the tank", p.name, p.y)));
+                return Err(err(
+                    "pressure_sensors.y",
+                    format!(
+                        "sensor {i} ({}) at y = {} m is outside the tank",
+                        p.name, p.y
+                    ),
+                ));
             }
             if !(p.z >= -tol && p.z <= self.tank.height + tol) {
-                return Err(err("pressure_sensors.z", format!("sensor {i} ({}) at z = {} m is outside the tank", p.name, p.z)));
+                return Err(err(
+                    "pressure_sensors.z",
+                    format!(
+                        "sensor {i} ({}) at z = {} m is outside the tank",
+                        p.name, p.z
+                    ),
+                ));
             }
         }
         Ok(())

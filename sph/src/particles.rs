@@ -22,6 +22,8 @@ pub struct Fluid<const D: usize> {
     pub v: [Vec<f32>; D],
     pub r: Vec<f32>,
     pub p: Vec<f32>,
+    /// p / ρ², the per-particle factor of the pressure gradient.
+    pub pr2: Vec<f32>,
     pub cell: Vec<u32>,
     /// Cell offsets of the sorted particles.
     pub starts: Vec<u32>,
@@ -57,6 +59,7 @@ impl<const D: usize> Default for Fluid<D> {
             v: vecs(),
             r: Vec::new(),
             p: Vec::new(),
+            pr2: Vec::new(),
             cell: Vec::new(),
             starts: Vec::new(),
             acc: Vec::new(),
@@ -74,6 +77,7 @@ impl<const D: usize> Default for Boundary<D> {
             rho0: Vec::new(),
             r: Vec::new(),
             p: Vec::new(),
+            pr2: Vec::new(),
             cell: Vec::new(),
             starts: Vec::new(),
             drho: Vec::new(),
@@ -116,7 +120,12 @@ impl<const D: usize> Fluid<D> {
         cells.clear();
         cells.extend((0..n).map(|i| grid.cell_of(self.position(i))));
         self.cell = cells;
-        let keep = counting_sort(grid.n_cells(), &self.cell, &mut self.starts, &mut scratch.dest);
+        let keep = counting_sort(
+            grid.n_cells(),
+            &self.cell,
+            &mut self.starts,
+            &mut scratch.dest,
+        );
         let dest = &scratch.dest;
         let s = &mut scratch.f64s;
         for k in 0..D {
@@ -135,19 +144,40 @@ impl<const D: usize> Fluid<D> {
 
     /// Refreshes the f32 copies and pressures from the integrated state.
     pub fn refresh(&mut self, eos: impl Fn(f32) -> f32 + Sync) {
+        use rayon::prelude::*;
         let n = self.len();
         for k in 0..D {
-            self.x[k].clear();
-            self.x[k].extend(self.pos[k].iter().map(|&v| v as f32));
-            self.v[k].clear();
-            self.v[k].extend(self.vel[k].iter().map(|&v| v as f32));
+            self.x[k].resize(n, 0.0);
+            self.v[k].resize(n, 0.0);
         }
-        self.r.clear();
-        self.r.extend(self.rho.iter().map(|&v| v as f32));
-        self.p.clear();
-        self.p.extend(self.r.iter().map(|&r| eos(r)));
+        self.r.resize(n, 0.0);
+        self.p.resize(n, 0.0);
+        self.pr2.resize(n, 0.0);
         self.acc.resize(n, [0.0; D]);
         self.drho.resize(n, 0.0);
+        const CH: usize = 4096;
+        for k in 0..D {
+            self.x[k]
+                .par_chunks_mut(CH)
+                .zip(self.pos[k].par_chunks(CH))
+                .for_each(|(o, i)| o.iter_mut().zip(i).for_each(|(o, i)| *o = *i as f32));
+            self.v[k]
+                .par_chunks_mut(CH)
+                .zip(self.vel[k].par_chunks(CH))
+                .for_each(|(o, i)| o.iter_mut().zip(i).for_each(|(o, i)| *o = *i as f32));
+        }
+        self.r
+            .par_chunks_mut(CH)
+            .zip(self.p.par_chunks_mut(CH))
+            .zip(self.pr2.par_chunks_mut(CH))
+            .zip(self.rho.par_chunks(CH))
+            .for_each(|(((r, p), pr2), rho)| {
+                for i in 0..r.len() {
+                    r[i] = rho[i] as f32;
+                    p[i] = eos(r[i]);
+                    pr2[i] = p[i] / (r[i] * r[i]);
+                }
+            });
     }
 }
 
@@ -162,6 +192,8 @@ pub struct Boundary<const D: usize> {
     pub rho0: Vec<f64>,
     pub r: Vec<f32>,
     pub p: Vec<f32>,
+    /// p / ρ².
+    pub pr2: Vec<f32>,
     pub cell: Vec<u32>,
     pub starts: Vec<u32>,
     pub drho: Vec<f32>,
@@ -185,6 +217,7 @@ impl<const D: usize> Boundary<D> {
         self.rho0.clear();
         self.r.clear();
         self.p.clear();
+        self.pr2.clear();
     }
 
     pub fn push(&mut self, x: [f64; D], v: [f64; D], rho: f64, p: f32) {
@@ -196,6 +229,7 @@ impl<const D: usize> Boundary<D> {
         self.rho0.push(rho);
         self.r.push(rho as f32);
         self.p.push(p);
+        self.pr2.push(p / (rho * rho) as f32);
     }
 
     /// Sorts by cell (points off the grid are dropped: they cannot reach any fluid particle).
@@ -205,7 +239,12 @@ impl<const D: usize> Boundary<D> {
         cells.clear();
         cells.extend((0..n).map(|i| grid.cell_of(std::array::from_fn(|k| self.x[k][i] as f64))));
         self.cell = cells;
-        let keep = counting_sort(grid.n_cells(), &self.cell, &mut self.starts, &mut scratch.dest);
+        let keep = counting_sort(
+            grid.n_cells(),
+            &self.cell,
+            &mut self.starts,
+            &mut scratch.dest,
+        );
         let dest = &scratch.dest;
         let s32 = &mut scratch.f32s;
         for k in 0..D {
@@ -214,6 +253,7 @@ impl<const D: usize> Boundary<D> {
         }
         permute(&mut self.r, dest, s32, keep);
         permute(&mut self.p, dest, s32, keep);
+        permute(&mut self.pr2, dest, s32, keep);
         permute(&mut self.rho, dest, &mut scratch.f64s, keep);
         permute(&mut self.rho0, dest, &mut scratch.f64s, keep);
         permute(&mut self.cell, dest, &mut scratch.u32s, keep);

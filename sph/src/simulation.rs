@@ -78,7 +78,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let margin = shell_layers as f64 * dp + support;
         let lo: [f64; D] = std::array::from_fn(|k| tank.lo[k] - margin);
         let hi: [f64; D] = std::array::from_fn(|k| tank.hi[k] + margin);
-        let grid = Grid::new(lo, hi, support);
+        let grid = Grid::new(lo, hi, 0.5 * support);
 
         // Liquid at rest with hydrostatic pressure below its own top.
         let (points, volume) = fluid_lattice::<D>(&params);
@@ -103,7 +103,10 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         };
         bound.sort(&grid, &mut scratch);
         let (shell_pts, shell_volume) = wall_lattice::<D>(&params, shell_layers);
-        let mut shell = Shell { points: dynamic::build(&shell_pts, |_| rho0, &eos), volume: shell_volume as f32 };
+        let mut shell = Shell {
+            points: dynamic::build(&shell_pts, |_| rho0, &eos),
+            volume: shell_volume as f32,
+        };
         shell.points.sort(&grid, &mut scratch);
         fluid.sort(&grid, &mut scratch);
 
@@ -117,14 +120,24 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             c0: c0 as f32,
             alpha: s.artificial_viscosity.alpha as f32,
             beta: s.artificial_viscosity.beta as f32,
-            alpha_bound: (s.artificial_viscosity.alpha * s.artificial_viscosity.boundary_factor) as f32,
-            beta_bound: (s.artificial_viscosity.beta * s.artificial_viscosity.boundary_factor) as f32,
+            alpha_bound: (s.artificial_viscosity.alpha * s.artificial_viscosity.boundary_factor)
+                as f32,
+            beta_bound: (s.artificial_viscosity.beta * s.artificial_viscosity.boundary_factor)
+                as f32,
             eta2: (s.artificial_viscosity.eta_factor * h * h) as f32,
             diffusion: s.density_diffusion.kind,
             delta_h_c0: (s.density_diffusion.delta * h * c0) as f32,
-            nu4: if s.laminar_viscosity { (4.0 * params.fluid.kinematic_viscosity) as f32 } else { 0.0 },
+            nu4: if s.laminar_viscosity {
+                (4.0 * params.fluid.kinematic_viscosity) as f32
+            } else {
+                0.0
+            },
         };
-        let dt_min = if s.dt_min > 0.0 { s.dt_min } else { 1e-4 * s.cfl * h / c0 };
+        let dt_min = if s.dt_min > 0.0 {
+            s.dt_min
+        } else {
+            1e-4 * s.cfl * h / c0
+        };
         Ok(Self {
             params,
             kernel,
@@ -136,7 +149,10 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             bound,
             shell,
             time: 0.0,
-            stats: Stats { min_dt: f64::INFINITY, ..Default::default() },
+            stats: Stats {
+                min_dt: f64::INFINITY,
+                ..Default::default()
+            },
             lost: 0,
             dt_min,
             last: PassTotals::default(),
@@ -150,7 +166,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     fn frame(&self, motion: &dyn TankMotion, t: f64) -> FrameTerms {
         let s = motion.state(t);
         let f = |v: nalgebra::Vector3<f64>| [v.x as f32, v.y as f32, v.z as f32];
-        FrameTerms { g: f(s.apparent_gravity(self.params.gravity)), w: f(s.angular_velocity), dw: f(s.angular_acceleration) }
+        FrameTerms {
+            g: f(s.apparent_gravity(self.params.gravity)),
+            w: f(s.angular_velocity),
+            dw: f(s.angular_acceleration),
+        }
     }
 
     /// Evaluates the rates at time t for the current state. `sort` re-bins the liquid first (once a step).
@@ -168,17 +188,41 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             BoundaryMethod::Dynamic => dynamic::refresh(&mut self.bound, &eos),
             BoundaryMethod::Mirror => {
                 let g: [f64; D] = from3(frame.g.map(|v| v as f64));
-                mirror::build_ghosts(&self.fluid, &self.tank, self.kernel.support() as f64, g, &eos, &mut self.bound);
+                mirror::build_ghosts(
+                    &self.fluid,
+                    &self.tank,
+                    self.kernel.support() as f64,
+                    g,
+                    &eos,
+                    &mut self.bound,
+                );
                 self.bound.sort(&self.grid, &mut self.scratch);
             }
         }
-        self.last = wcsph::fluid_rates(&self.kernel, &self.coef, &self.grid, &frame, &mut self.fluid, &self.bound, &mut self.partials);
+        self.last = wcsph::fluid_rates(
+            &self.kernel,
+            &self.coef,
+            &self.grid,
+            &frame,
+            &mut self.fluid,
+            &self.bound,
+            &mut self.partials,
+        );
         if self.params.solver.boundary.method == BoundaryMethod::Dynamic {
-            wcsph::wall_density_rates(&self.kernel, &self.coef, &self.grid, &self.fluid, &mut self.bound);
+            wcsph::wall_density_rates(
+                &self.kernel,
+                &self.coef,
+                &self.grid,
+                &self.fluid,
+                &mut self.bound,
+            );
         }
         self.stats.force_evaluations += 1;
         if self.last.non_finite {
-            return Err(SimError::NonFinite { time: t, step: self.stats.steps });
+            return Err(SimError::NonFinite {
+                time: t,
+                step: self.stats.steps,
+            });
         }
         Ok(())
     }
@@ -189,7 +233,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let h = self.coef.h as f64;
         let rmax = self.fluid.r.iter().fold(self.coef.rho0, |m, &r| m.max(r));
         let cmax = self.eos.sound_speed(rmax) as f64;
-        let dt_f = if self.last.max_acc > 0.0 { (h / self.last.max_acc as f64).sqrt() } else { f64::INFINITY };
+        let dt_f = if self.last.max_acc > 0.0 {
+            (h / self.last.max_acc as f64).sqrt()
+        } else {
+            f64::INFINITY
+        };
         let dt_cv = h / (cmax + self.last.max_mu as f64);
         let mut dt = s.cfl * dt_f.min(dt_cv);
         if s.laminar_viscosity {
@@ -197,7 +245,12 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         }
         dt = dt.min(s.dt_max);
         if !(dt >= self.dt_min) {
-            return Err(SimError::TimeStepCollapsed { time: self.time, step: self.stats.steps, dt, dt_min: self.dt_min });
+            return Err(SimError::TimeStepCollapsed {
+                time: self.time,
+                step: self.stats.steps,
+                dt,
+                dt_min: self.dt_min,
+            });
         }
         Ok(dt)
     }
@@ -211,27 +264,45 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         self.rates_current = false;
         let dt = self.time_step()?;
         if t + dt > motion.end_time() + 1e-12 {
-            return Err(SimError::MotionEnded { time: t + dt, end: motion.end_time() });
+            return Err(SimError::MotionEnded {
+                time: t + dt,
+                end: motion.end_time(),
+            });
         }
         let walls = self.params.solver.boundary.method == BoundaryMethod::Dynamic;
         match self.params.solver.integrator {
             Integrator::Symplectic => {
-                integrate::symplectic_predict(&mut self.fluid, walls.then_some(&mut self.bound), dt);
+                integrate::symplectic_predict(
+                    &mut self.fluid,
+                    walls.then_some(&mut self.bound),
+                    dt,
+                );
                 if walls {
                     dynamic::clamp(&mut self.bound, self.eos.rho0 as f64);
                 }
                 self.evaluate(motion, t + 0.5 * dt, false)?;
-                integrate::symplectic_correct(&mut self.fluid, walls.then_some(&mut self.bound), dt);
+                integrate::symplectic_correct(
+                    &mut self.fluid,
+                    walls.then_some(&mut self.bound),
+                    dt,
+                );
             }
             Integrator::Verlet => {
-                let euler = self.stats.steps % self.params.solver.verlet_reset_steps as u64 == 0;
+                let euler = self
+                    .stats
+                    .steps
+                    .is_multiple_of(self.params.solver.verlet_reset_steps as u64);
                 integrate::verlet(&mut self.fluid, walls.then_some(&mut self.bound), dt, euler);
             }
         }
         if walls {
             dynamic::clamp(&mut self.bound, self.eos.rho0 as f64);
         } else {
-            mirror::restrain(&mut self.fluid, &self.tank, 0.25 * self.params.particle_spacing);
+            mirror::restrain(
+                &mut self.fluid,
+                &self.tank,
+                0.25 * self.params.particle_spacing,
+            );
         }
         self.time = t + dt;
         self.stats.steps += 1;
@@ -262,7 +333,18 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             .params
             .probes
             .iter()
-            .map(|p| probes::elevation(k, &self.grid, &self.fluid, m, &self.shell, [p.x, p.y], top, 0.25 * dp))
+            .map(|p| {
+                probes::elevation(
+                    k,
+                    &self.grid,
+                    &self.fluid,
+                    m,
+                    &self.shell,
+                    [p.x, p.y],
+                    top,
+                    0.25 * dp,
+                )
+            })
             .collect();
         let pressures = self
             .params
@@ -271,9 +353,21 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             .map(|s| pressure::pressure(k, &self.grid, &self.fluid, m, from3([s.x, s.y, s.z])))
             .collect();
         // The boundary's force on the liquid, reversed; a 2D result stands for the tank's breadth.
-        let scale = if D == 2 { -self.params.tank.breadth } else { -1.0 };
-        let wrench = Wrench { force: self.last.force.map(|v| v * scale), moment: self.last.moment.map(|v| v * scale) };
-        Ok(Observation { time: self.time, probes, pressures, wrench })
+        let scale = if D == 2 {
+            -self.params.tank.breadth
+        } else {
+            -1.0
+        };
+        let wrench = Wrench {
+            force: self.last.force.map(|v| v * scale),
+            moment: self.last.moment.map(|v| v * scale),
+        };
+        Ok(Observation {
+            time: self.time,
+            probes,
+            pressures,
+            wrench,
+        })
     }
 
     pub fn time(&self) -> f64 {
@@ -285,7 +379,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     }
 
     pub fn counts(&self) -> Counts {
-        Counts { fluid: self.fluid.len(), boundary: self.bound.len(), lost: self.lost }
+        Counts {
+            fluid: self.fluid.len(),
+            boundary: self.bound.len(),
+            lost: self.lost,
+        }
     }
 
     pub fn params(&self) -> &SimParams {
@@ -304,12 +402,16 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     /// Liquid particle positions in the tank frame as x, y, z.
     pub fn fluid_positions(&self) -> Vec<[f64; 3]> {
-        (0..self.fluid.len()).map(|i| to3(self.fluid.position(i))).collect()
+        (0..self.fluid.len())
+            .map(|i| to3(self.fluid.position(i)))
+            .collect()
     }
 
     /// Liquid particle velocities relative to the tank as x, y, z.
     pub fn fluid_velocities(&self) -> Vec<[f64; 3]> {
-        (0..self.fluid.len()).map(|i| to3(std::array::from_fn::<f64, D, _>(|k| self.fluid.vel[k][i]))).collect()
+        (0..self.fluid.len())
+            .map(|i| to3(std::array::from_fn::<f64, D, _>(|k| self.fluid.vel[k][i])))
+            .collect()
     }
 
     /// Sets every liquid particle's velocity from its position (x, y, z in, x, y, z out): initial conditions.

@@ -110,8 +110,15 @@ mod tests {
     fn params(dim: usize) -> SimParams {
         SimParams {
             dimension: dim,
-            tank: TankSpec { length: 0.8, breadth: 0.25, height: 0.6 },
-            fill: FillSpec { height: 0.39, length: 0.0 },
+            tank: TankSpec {
+                length: 0.8,
+                breadth: 0.25,
+                height: 0.6,
+            },
+            fill: FillSpec {
+                height: 0.39,
+                length: 0.0,
+            },
             particle_spacing: 0.02,
             fluid: FluidSpec::default(),
             gravity: 9.81,
@@ -131,7 +138,9 @@ mod tests {
         let p2 = params(2);
         let (pts2, v2) = fluid_lattice::<2>(&p2);
         assert!((pts2.len() as f64 * v2 - 0.8 * 0.39).abs() < 1e-12);
-        assert!(pts2.iter().all(|x| x[0] > -0.4 && x[0] < 0.4 && x[1] > 0.0 && x[1] < 0.39));
+        assert!(pts2
+            .iter()
+            .all(|x| x[0] > -0.4 && x[0] < 0.4 && x[1] > 0.0 && x[1] < 0.39));
     }
 
     #[test]

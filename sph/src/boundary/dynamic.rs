@@ -6,7 +6,11 @@ use crate::eos::Tait;
 use crate::particles::Boundary;
 
 /// Wall particles at `points` with their initial density.
-pub fn build<const D: usize>(points: &[[f64; D]], density: impl Fn([f64; D]) -> f64, eos: &Tait) -> Boundary<D> {
+pub fn build<const D: usize>(
+    points: &[[f64; D]],
+    density: impl Fn([f64; D]) -> f64,
+    eos: &Tait,
+) -> Boundary<D> {
     let mut b = Boundary::default();
     for p in points {
         let rho = density(*p).max(eos.rho0 as f64);
@@ -21,6 +25,7 @@ pub fn refresh<const D: usize>(b: &mut Boundary<D>, eos: &Tait) {
         let r = b.rho[i] as f32;
         b.r[i] = r;
         b.p[i] = eos.pressure(r);
+        b.pr2[i] = b.p[i] / (r * r);
     }
 }
 

@@ -9,7 +9,14 @@ use crate::particles::{Boundary, Fluid};
 use crate::tank::TankBox;
 
 /// Rebuilds `ghosts` from the liquid's interaction copies. `g` is the apparent gravity in the tank frame.
-pub fn build_ghosts<const D: usize>(fluid: &Fluid<D>, tank: &TankBox<D>, support: f64, g: [f64; D], eos: &Tait, ghosts: &mut Boundary<D>) {
+pub fn build_ghosts<const D: usize>(
+    fluid: &Fluid<D>,
+    tank: &TankBox<D>,
+    support: f64,
+    g: [f64; D],
+    eos: &Tait,
+    ghosts: &mut Boundary<D>,
+) {
     ghosts.clear();
     for i in 0..fluid.len() {
         let x: [f64; D] = std::array::from_fn(|k| fluid.x[k][i] as f64);

@@ -19,7 +19,11 @@ impl Kernel for CubicSpline {
             3 => 1.0 / PI,
             _ => panic!("dimension must be 2 or 3"),
         };
-        Self { h, inv_h: 1.0 / h, norm: sigma / h.powi(dim as i32) }
+        Self {
+            h,
+            inv_h: 1.0 / h,
+            norm: sigma / h.powi(dim as i32),
+        }
     }
 
     fn h(&self) -> f32 {

@@ -96,7 +96,11 @@ mod tests {
                 let fd = (kd.w((r + e) as f32) as f64 - kd.w((r - e) as f32) as f64) / (2.0 * e);
                 let an = kd.grad_factor(r as f32) as f64 * r;
                 let scale = (kd.w(0.0) as f64) / h as f64;
-                assert!((fd - an).abs() < 2e-3 * scale, "dim {dim} r/h {}: fd {fd} analytic {an}", r / h as f64);
+                assert!(
+                    (fd - an).abs() < 2e-3 * scale,
+                    "dim {dim} r/h {}: fd {fd} analytic {an}",
+                    r / h as f64
+                );
             }
             // gradient antisymmetry: grad_a W(x_a - x_b) = -grad_b W(x_b - x_a)
             let (xa, xb) = ([0.001f32, 0.004, -0.002], [0.009f32, -0.003, 0.005]);

@@ -17,7 +17,11 @@ impl Kernel for WendlandC2 {
             3 => 21.0 / (16.0 * PI * h * h * h),
             _ => panic!("dimension must be 2 or 3"),
         };
-        Self { h, inv_h: 1.0 / h, norm }
+        Self {
+            h,
+            inv_h: 1.0 / h,
+            norm,
+        }
     }
 
     fn h(&self) -> f32 {

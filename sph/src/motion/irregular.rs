@@ -43,7 +43,13 @@ fn jonswap_shape(w: f64, wp: f64, gamma: f64) -> f64 {
 
 impl IrregularMotion {
     /// `components` sines per DOF between 0.5 ωp and 3 ωp, peak enhancement `gamma` (3.3 is typical).
-    pub fn new(dofs: &[JonswapDof; 6], gamma: f64, components: usize, seed: u64, ramp: f64) -> Self {
+    pub fn new(
+        dofs: &[JonswapDof; 6],
+        gamma: f64,
+        components: usize,
+        seed: u64,
+        ramp: f64,
+    ) -> Self {
         let mut out: [Vec<(f64, f64, f64)>; 6] = Default::default();
         for (i, dof) in dofs.iter().enumerate() {
             if dof.significant_amplitude == 0.0 || dof.peak_period <= 0.0 || components == 0 {
@@ -69,7 +75,10 @@ impl IrregularMotion {
             }
             out[i] = comps;
         }
-        Self { components: out, ramp }
+        Self {
+            components: out,
+            ramp,
+        }
     }
 }
 
@@ -100,7 +109,10 @@ mod tests {
     #[test]
     fn irregular_motion_is_reproducible_and_has_the_requested_statistics() {
         let mut dofs = [JonswapDof::default(); 6];
-        dofs[3] = JonswapDof { significant_amplitude: 0.1, peak_period: 2.0 };
+        dofs[3] = JonswapDof {
+            significant_amplitude: 0.1,
+            peak_period: 2.0,
+        };
         let a = IrregularMotion::new(&dofs, 3.3, 200, 7, 0.0);
         let b = IrregularMotion::new(&dofs, 3.3, 200, 7, 0.0);
         let c = IrregularMotion::new(&dofs, 3.3, 200, 8, 0.0);
@@ -109,7 +121,10 @@ mod tests {
         // Standard deviation over a long record ≈ sqrt(m0) = 0.05.
         let n = 200_000;
         let dt = 0.01;
-        let var: f64 = (0..n).map(|k| a.dof(k as f64 * dt).q[3].powi(2)).sum::<f64>() / n as f64;
+        let var: f64 = (0..n)
+            .map(|k| a.dof(k as f64 * dt).q[3].powi(2))
+            .sum::<f64>()
+            / n as f64;
         assert!((var.sqrt() - 0.05).abs() < 0.005, "std {}", var.sqrt());
         assert_eq!(a.dof(3.0).q[0], 0.0);
         // Derivatives consistent.

@@ -44,7 +44,8 @@ impl RigidState {
     /// The apparent gravity in the tank frame, R^T (g − a), with g = (0, 0, −gravity) in the world.
     pub fn apparent_gravity(&self, gravity: f64) -> Vector3<f64> {
         let g = Vector3::new(0.0, 0.0, -gravity);
-        self.orientation.inverse_transform_vector(&(g - self.acceleration))
+        self.orientation
+            .inverse_transform_vector(&(g - self.acceleration))
     }
 
     /// Velocity in the world of a point fixed to the tank at `r` (tank frame): v + R (ω × r).
@@ -79,8 +80,11 @@ impl Dof6 {
         );
         let dw = Vector3::new(
             ddphi - ddpsi * st - dpsi * dtheta * ct,
-            ddtheta * cf - dtheta * dphi * sf + ddpsi * sf * ct + dpsi * dphi * cf * ct - dpsi * dtheta * sf * st,
-            -ddtheta * sf - dtheta * dphi * cf + ddpsi * cf * ct - dpsi * dphi * sf * ct - dpsi * dtheta * cf * st,
+            ddtheta * cf - dtheta * dphi * sf + ddpsi * sf * ct + dpsi * dphi * cf * ct
+                - dpsi * dtheta * sf * st,
+            -ddtheta * sf - dtheta * dphi * cf + ddpsi * cf * ct
+                - dpsi * dphi * sf * ct
+                - dpsi * dtheta * cf * st,
         );
         RigidState {
             position: Vector3::new(x, y, z),
@@ -158,7 +162,11 @@ pub(crate) fn ramp(t: f64, ramp: f64) -> (f64, f64, f64) {
         return (0.0, 0.0, 0.0);
     }
     let a = std::f64::consts::PI / ramp;
-    (0.5 * (1.0 - (a * t).cos()), 0.5 * a * (a * t).sin(), 0.5 * a * a * (a * t).cos())
+    (
+        0.5 * (1.0 - (a * t).cos()),
+        0.5 * a * (a * t).sin(),
+        0.5 * a * a * (a * t).cos(),
+    )
 }
 
 #[cfg(test)]
@@ -171,15 +179,27 @@ mod tests {
         for i in 0..6 {
             let fd1 = (c.q[i] - a.q[i]) / (2.0 * e);
             let fd2 = (c.dq[i] - a.dq[i]) / (2.0 * e);
-            assert!((fd1 - b.dq[i]).abs() < 1e-6 * (1.0 + b.dq[i].abs()), "dof {i}: {fd1} vs {}", b.dq[i]);
-            assert!((fd2 - b.ddq[i]).abs() < 1e-5 * (1.0 + b.ddq[i].abs()), "dof {i}: {fd2} vs {}", b.ddq[i]);
+            assert!(
+                (fd1 - b.dq[i]).abs() < 1e-6 * (1.0 + b.dq[i].abs()),
+                "dof {i}: {fd1} vs {}",
+                b.dq[i]
+            );
+            assert!(
+                (fd2 - b.ddq[i]).abs() < 1e-5 * (1.0 + b.ddq[i].abs()),
+                "dof {i}: {fd2} vs {}",
+                b.ddq[i]
+            );
         }
         // Angular velocity and acceleration against differences of the orientation.
         let (sa, sb, sc) = (a.to_state(), b.to_state(), c.to_state());
         let dr = sb.orientation.inverse() * sc.orientation;
         let dl = sa.orientation.inverse() * sb.orientation;
         let w_fd = (dr.scaled_axis() + dl.scaled_axis()) / (2.0 * e);
-        assert!((w_fd - sb.angular_velocity).norm() < 1e-6 * (1.0 + sb.angular_velocity.norm()), "{w_fd} vs {}", sb.angular_velocity);
+        assert!(
+            (w_fd - sb.angular_velocity).norm() < 1e-6 * (1.0 + sb.angular_velocity.norm()),
+            "{w_fd} vs {}",
+            sb.angular_velocity
+        );
         let dw_fd = (sc.angular_velocity - sa.angular_velocity) / (2.0 * e);
         assert!((dw_fd - sb.angular_acceleration).norm() < 1e-5 * (1.0 + dw_fd.norm()));
     }
@@ -188,12 +208,36 @@ mod tests {
     fn regular_motion_derivatives_are_consistent() {
         let m = RegularMotion {
             dofs: [
-                RegularDof { amplitude: 0.1, period: 2.0, phase: 0.3 },
-                RegularDof { amplitude: 0.05, period: 3.0, phase: 0.0 },
-                RegularDof { amplitude: 0.2, period: 7.0, phase: 1.0 },
-                RegularDof { amplitude: 0.2, period: 5.0, phase: 0.0 },
-                RegularDof { amplitude: 0.1, period: 4.0, phase: 2.0 },
-                RegularDof { amplitude: 0.3, period: 9.0, phase: 0.5 },
+                RegularDof {
+                    amplitude: 0.1,
+                    period: 2.0,
+                    phase: 0.3,
+                },
+                RegularDof {
+                    amplitude: 0.05,
+                    period: 3.0,
+                    phase: 0.0,
+                },
+                RegularDof {
+                    amplitude: 0.2,
+                    period: 7.0,
+                    phase: 1.0,
+                },
+                RegularDof {
+                    amplitude: 0.2,
+                    period: 5.0,
+                    phase: 0.0,
+                },
+                RegularDof {
+                    amplitude: 0.1,
+                    period: 4.0,
+                    phase: 2.0,
+                },
+                RegularDof {
+                    amplitude: 0.3,
+                    period: 9.0,
+                    phase: 0.5,
+                },
             ],
             ramp: 3.0,
         };
@@ -206,11 +250,16 @@ mod tests {
     fn apparent_gravity_of_a_tilted_accelerating_tank() {
         // Pitched by 0.1 rad (nose down about +y) and accelerating forward: the apparent gravity in the tank
         // frame has the rotated and the inertial part.
-        let d = Dof6 { q: [0.0, 0.0, 0.0, 0.0, 0.1, 0.0], dq: [0.0; 6], ddq: [2.0, 0.0, 0.0, 0.0, 0.0, 0.0] };
+        let d = Dof6 {
+            q: [0.0, 0.0, 0.0, 0.0, 0.1, 0.0],
+            dq: [0.0; 6],
+            ddq: [2.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        };
         let s = d.to_state();
         let g = s.apparent_gravity(9.81);
         assert!((g.norm() - (9.81f64.powi(2) + 4.0).sqrt()).abs() < 1e-12);
-        let expect = Rotation3::from_euler_angles(0.0, 0.1, 0.0).inverse() * Vector3::new(-2.0, 0.0, -9.81);
+        let expect =
+            Rotation3::from_euler_angles(0.0, 0.1, 0.0).inverse() * Vector3::new(-2.0, 0.0, -9.81);
         assert!((g - expect).norm() < 1e-12);
     }
 }

@@ -11,7 +11,11 @@ pub enum SampleError {
     #[error("sample {index}: {what} is not a finite number")]
     NotFinite { index: usize, what: &'static str },
     #[error("sample {index}: time {time} s is not after the previous sample's {previous} s (times must increase strictly)")]
-    NotIncreasing { index: usize, time: f64, previous: f64 },
+    NotIncreasing {
+        index: usize,
+        time: f64,
+        previous: f64,
+    },
 }
 
 /// One cubic spline: knots and second derivatives.
@@ -55,7 +59,8 @@ impl Spline {
         let b = (x - t[i]) / h;
         let (m0, m1, y0, y1) = (self.m[i], self.m[i + 1], self.y[i], self.y[i + 1]);
         let v = a * y0 + b * y1 + ((a * a * a - a) * m0 + (b * b * b - b) * m1) * h * h / 6.0;
-        let d1 = (y1 - y0) / h - (3.0 * a * a - 1.0) / 6.0 * h * m0 + (3.0 * b * b - 1.0) / 6.0 * h * m1;
+        let d1 =
+            (y1 - y0) / h - (3.0 * a * a - 1.0) / 6.0 * h * m0 + (3.0 * b * b - 1.0) / 6.0 * h * m1;
         let d2 = a * m0 + b * m1;
         (v, d1, d2)
     }
@@ -77,15 +82,25 @@ impl SampledMotion {
         const NAMES: [&str; 6] = ["x", "y", "z", "roll", "pitch", "yaw"];
         for (i, (t, p)) in times.iter().zip(poses).enumerate() {
             if !t.is_finite() {
-                return Err(SampleError::NotFinite { index: i, what: "time" });
+                return Err(SampleError::NotFinite {
+                    index: i,
+                    what: "time",
+                });
             }
             for (k, v) in p.iter().enumerate() {
                 if !v.is_finite() {
-                    return Err(SampleError::NotFinite { index: i, what: NAMES[k] });
+                    return Err(SampleError::NotFinite {
+                        index: i,
+                        what: NAMES[k],
+                    });
                 }
             }
             if i > 0 && *t <= times[i - 1] {
-                return Err(SampleError::NotIncreasing { index: i, time: *t, previous: times[i - 1] });
+                return Err(SampleError::NotIncreasing {
+                    index: i,
+                    time: *t,
+                    previous: times[i - 1],
+                });
             }
         }
         let splines = (0..6)
@@ -119,7 +134,11 @@ impl Dof6Motion for SampledMotion {
             }
             return d;
         }
-        let i = self.t.partition_point(|&v| v <= x).saturating_sub(1).min(n - 2);
+        let i = self
+            .t
+            .partition_point(|&v| v <= x)
+            .saturating_sub(1)
+            .min(n - 2);
         for k in 0..6 {
             let (v, d1, d2) = self.splines[k].eval(&self.t, i, x);
             d.q[k] = v;
@@ -141,7 +160,19 @@ mod tests {
     #[test]
     fn spline_reproduces_a_smooth_signal_and_its_derivatives() {
         let times: Vec<f64> = (0..=400).map(|i| i as f64 * 0.025).collect();
-        let poses: Vec<[f64; 6]> = times.iter().map(|&t| [0.1 * (2.0 * t).sin(), 0.0, 5000.0 + 3.0 * t, 0.0, 0.05 * t.cos(), 0.0]).collect();
+        let poses: Vec<[f64; 6]> = times
+            .iter()
+            .map(|&t| {
+                [
+                    0.1 * (2.0 * t).sin(),
+                    0.0,
+                    5000.0 + 3.0 * t,
+                    0.0,
+                    0.05 * t.cos(),
+                    0.0,
+                ]
+            })
+            .collect();
         let m = SampledMotion::new(times, &poses).unwrap();
         for &t in &[1.013, 3.5, 7.777] {
             let d = m.dof(t);
@@ -158,17 +189,38 @@ mod tests {
     #[test]
     fn bad_samples_are_rejected_with_their_index() {
         let p = [[0.0; 6]; 3];
-        assert_eq!(SampledMotion::new(vec![0.0, 1.0, 1.0], &p).unwrap_err(), SampleError::NotIncreasing { index: 2, time: 1.0, previous: 1.0 });
+        assert_eq!(
+            SampledMotion::new(vec![0.0, 1.0, 1.0], &p).unwrap_err(),
+            SampleError::NotIncreasing {
+                index: 2,
+                time: 1.0,
+                previous: 1.0
+            }
+        );
         let mut q = p;
         q[1][3] = f64::NAN;
-        assert_eq!(SampledMotion::new(vec![0.0, 1.0, 2.0], &q).unwrap_err(), SampleError::NotFinite { index: 1, what: "roll" });
-        assert!(matches!(SampledMotion::new(vec![0.0], &p[..1]), Err(SampleError::TooFew(1))));
+        assert_eq!(
+            SampledMotion::new(vec![0.0, 1.0, 2.0], &q).unwrap_err(),
+            SampleError::NotFinite {
+                index: 1,
+                what: "roll"
+            }
+        );
+        assert!(matches!(
+            SampledMotion::new(vec![0.0], &p[..1]),
+            Err(SampleError::TooFew(1))
+        ));
     }
 
     #[test]
     fn angles_are_unwrapped() {
         let times = vec![0.0, 1.0, 2.0, 3.0];
-        let poses = [[0.0, 0.0, 0.0, 0.0, 0.0, 3.0], [0.0, 0.0, 0.0, 0.0, 0.0, 3.1], [0.0, 0.0, 0.0, 0.0, 0.0, -3.1], [0.0, 0.0, 0.0, 0.0, 0.0, -3.0]];
+        let poses = [
+            [0.0, 0.0, 0.0, 0.0, 0.0, 3.0],
+            [0.0, 0.0, 0.0, 0.0, 0.0, 3.1],
+            [0.0, 0.0, 0.0, 0.0, 0.0, -3.1],
+            [0.0, 0.0, 0.0, 0.0, 0.0, -3.0],
+        ];
         let m = SampledMotion::new(times, &poses).unwrap();
         assert!(m.dof(1.5).q[5] > 3.1 && m.dof(1.5).q[5] < 3.2);
     }

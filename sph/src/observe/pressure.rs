@@ -2,11 +2,17 @@
 //! p = Σ p_j V_j W / Σ V_j W. A sensor with too little liquid in reach (Σ V_j W < 0.1) reads 0 (dry).
 
 use crate::kernel::Kernel;
-use crate::neighbours::{Grid, Ranges};
+use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::particles::Fluid;
 
-pub fn pressure<const D: usize, K: Kernel>(k: &K, grid: &Grid<D>, fluid: &Fluid<D>, m_fluid: f32, p: [f64; D]) -> f64 {
-    let mut ranges: Ranges = [(0, 0); 9];
+pub fn pressure<const D: usize, K: Kernel>(
+    k: &K,
+    grid: &Grid<D>,
+    fluid: &Fluid<D>,
+    m_fluid: f32,
+    p: [f64; D],
+) -> f64 {
+    let mut ranges: Ranges = NO_RANGES;
     let s2 = k.support() * k.support();
     let pf: [f32; D] = std::array::from_fn(|d| p[d] as f32);
     let n = grid.ranges_around(p, &fluid.starts, &mut ranges);

@@ -19,7 +19,13 @@ impl FrameTerms {
     /// g − ω̇ × r − ω × (ω × r) − 2 ω × v.
     #[inline(always)]
     pub fn acceleration(&self, r: [f32; 3], v: [f32; 3]) -> [f32; 3] {
-        let cross = |a: [f32; 3], b: [f32; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+        let cross = |a: [f32; 3], b: [f32; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
         let euler = cross(self.dw, r);
         let wr = cross(self.w, r);
         let centri = cross(self.w, wr);

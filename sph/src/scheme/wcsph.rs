@@ -7,7 +7,7 @@
 
 use super::{FrameTerms, PassTotals};
 use crate::kernel::Kernel;
-use crate::neighbours::{Grid, Ranges};
+use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DiffusionKind;
 use crate::particles::{Boundary, Fluid};
 use crate::tank::{from3, to3};
@@ -62,18 +62,26 @@ fn interact<const D: usize, K: Kernel, const FLUID: bool>(
     x: &[Vec<f32>; D],
     v: &[Vec<f32>; D],
     rho: &[f32],
-    p: &[f32],
+    pr2: &[f32],
     (lo, hi): (u32, u32),
     out: &mut Acc<D>,
 ) {
-    let (lo, hi) = (lo as usize, hi as usize);
-    let xs: [&[f32]; D] = std::array::from_fn(|d| &x[d][lo..hi]);
-    let vs: [&[f32]; D] = std::array::from_fn(|d| &v[d][lo..hi]);
-    let rs = &rho[lo..hi];
-    let ps = &p[lo..hi];
+    let (lo, n) = (lo as usize, (hi - lo) as usize);
+    let xs: [&[f32]; D] = std::array::from_fn(|d| &x[d][lo..lo + n]);
+    let vs: [&[f32]; D] = std::array::from_fn(|d| &v[d][lo..lo + n]);
+    let rs = &rho[lo..lo + n];
+    let ps = &pr2[lo..lo + n];
     let m = if FLUID { c.m_fluid } else { c.m_bound };
-    let (alpha, beta) = if FLUID { (c.alpha, c.beta) } else { (c.alpha_bound, c.beta_bound) };
-    for j in 0..rs.len() {
+    let (alpha, beta) = if FLUID {
+        (c.alpha, c.beta)
+    } else {
+        (c.alpha_bound, c.beta_bound)
+    };
+    let diffusion = FLUID && c.diffusion != DiffusionKind::None;
+    let fourtakas = c.diffusion == DiffusionKind::Fourtakas;
+    let inv_c0_sq = 1.0 / (c.c0 * c.c0);
+    let dhc = 2.0 * c.delta_h_c0 * m;
+    for j in 0..n {
         let mut dx = [0.0f32; D];
         let mut r2 = 0.0f32;
         for d in 0..D {
@@ -83,40 +91,44 @@ fn interact<const D: usize, K: Kernel, const FLUID: bool>(
         if r2 >= c.support2 {
             continue;
         }
-        let f = k.grad_factor(r2.sqrt());
-        let (rb, pb) = (rs[j], ps[j]);
         let mut vd = [0.0f32; D];
         let mut vr = 0.0f32;
         for d in 0..D {
             vd[d] = va[d] - vs[d][j];
             vr += vd[d] * dx[d];
         }
+        let f = k.grad_factor(r2.sqrt());
+        let (rb, pb_r2) = (rs[j], ps[j]);
         let inv_r2e = 1.0 / (r2 + c.eta2);
-        let mut s = pa_r2 + pb / (rb * rb);
+        let mut s = pa_r2 + pb_r2;
         if vr < 0.0 {
             let mu = c.h * vr * inv_r2e;
             out.max_mu = out.max_mu.max(-mu);
             s += (-alpha * c.c0 * mu + beta * mu * mu) * 2.0 / (ra + rb);
         }
         let sf = -m * s * f;
-        let lam = if c.nu4 > 0.0 { m * c.nu4 * f * r2 * inv_r2e / (ra + rb) } else { 0.0 };
+        let lam = if c.nu4 > 0.0 {
+            m * c.nu4 * f * r2 * inv_r2e / (ra + rb)
+        } else {
+            0.0
+        };
         let mut pair = [0.0f32; D];
         for d in 0..D {
             pair[d] = sf * dx[d] + lam * vd[d];
             out.acc[d] += pair[d];
         }
         out.drho += m * vr * f;
-        if FLUID && c.diffusion != DiffusionKind::None {
+        if diffusion {
             let mut diff = rb - ra;
-            if c.diffusion == DiffusionKind::Fourtakas {
+            if fourtakas {
                 // Remove the hydrostatic density difference ρ0 g·(x_b − x_a) / c0².
                 let mut gd = 0.0f32;
                 for d in 0..D {
                     gd -= g[d] * dx[d];
                 }
-                diff -= c.rho0 * gd / (c.c0 * c.c0);
+                diff -= c.rho0 * gd * inv_c0_sq;
             }
-            out.drho -= c.delta_h_c0 * 2.0 * diff * f * r2 * inv_r2e * m / rb;
+            out.drho -= dhc * diff * f * r2 * inv_r2e / rb;
         }
         if !FLUID {
             for d in 0..D {
@@ -142,8 +154,18 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
     bound: &Boundary<D>,
     partials: &mut Vec<PassTotals>,
 ) -> PassTotals {
-    let Fluid { x, v, r, p, cell, starts, acc, drho, .. } = fluid;
-    let (x, v, r, p, cell, starts) = (&*x, &*v, &*r, &*p, &*cell, &*starts);
+    let Fluid {
+        x,
+        v,
+        r,
+        pr2,
+        cell,
+        starts,
+        acc,
+        drho,
+        ..
+    } = fluid;
+    let (x, v, r, pr2, cell, starts) = (&*x, &*v, &*r, &*pr2, &*cell, &*starts);
     let g: [f32; D] = from3(frame.g);
     let mass = c.m_fluid as f64;
     acc.par_chunks_mut(CHUNK)
@@ -151,22 +173,30 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
         .enumerate()
         .map(|(ci, (acc_c, drho_c))| {
             let mut tot = PassTotals::default();
-            let mut fr: Ranges = [(0, 0); 9];
-            let mut br: Ranges = [(0, 0); 9];
+            let mut fr: Ranges = NO_RANGES;
+            let mut br: Ranges = NO_RANGES;
             for (o, (acc_a, drho_a)) in acc_c.iter_mut().zip(drho_c.iter_mut()).enumerate() {
                 let a = ci * CHUNK + o;
                 let xa: [f32; D] = std::array::from_fn(|d| x[d][a]);
                 let va: [f32; D] = std::array::from_fn(|d| v[d][a]);
-                let (ra, pa) = (r[a], p[a]);
-                let pa_r2 = pa / (ra * ra);
-                let mut out = Acc { acc: [0.0; D], drho: 0.0, max_mu: 0.0, force: [0.0; D], moment: [0.0; 3] };
+                let (ra, pa_r2) = (r[a], pr2[a]);
+                let mut out = Acc {
+                    acc: [0.0; D],
+                    drho: 0.0,
+                    max_mu: 0.0,
+                    force: [0.0; D],
+                    moment: [0.0; 3],
+                };
                 let nf = grid.ranges(cell[a], starts, &mut fr);
                 for &rg in &fr[..nf] {
-                    interact::<D, K, true>(k, c, g, xa, va, ra, pa_r2, x, v, r, p, rg, &mut out);
+                    interact::<D, K, true>(k, c, g, xa, va, ra, pa_r2, x, v, r, pr2, rg, &mut out);
                 }
                 let nb = grid.ranges(cell[a], &bound.starts, &mut br);
                 for &rg in &br[..nb] {
-                    interact::<D, K, false>(k, c, g, xa, va, ra, pa_r2, &bound.x, &bound.v, &bound.r, &bound.p, rg, &mut out);
+                    interact::<D, K, false>(
+                        k, c, g, xa, va, ra, pa_r2, &bound.x, &bound.v, &bound.r, &bound.pr2, rg,
+                        &mut out,
+                    );
                 }
                 let fa = frame.acceleration(to3(xa), to3(va));
                 let fa: [f32; D] = from3(fa);
@@ -198,31 +228,44 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
 }
 
 /// Density rate of dynamic wall particles by continuity with the liquid (walls at rest in the tank frame).
-pub fn wall_density_rates<const D: usize, K: Kernel>(k: &K, c: &Coefficients, grid: &Grid<D>, fluid: &Fluid<D>, bound: &mut Boundary<D>) {
-    let Boundary { x: bx, cell: bcell, drho, .. } = bound;
+pub fn wall_density_rates<const D: usize, K: Kernel>(
+    k: &K,
+    c: &Coefficients,
+    grid: &Grid<D>,
+    fluid: &Fluid<D>,
+    bound: &mut Boundary<D>,
+) {
+    let Boundary {
+        x: bx,
+        cell: bcell,
+        drho,
+        ..
+    } = bound;
     let (bx, bcell) = (&*bx, &*bcell);
-    drho.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, chunk)| {
-        let mut fr: Ranges = [(0, 0); 9];
-        for (o, out) in chunk.iter_mut().enumerate() {
-            let b = ci * CHUNK + o;
-            let xb: [f32; D] = std::array::from_fn(|d| bx[d][b]);
-            let n = grid.ranges(bcell[b], &fluid.starts, &mut fr);
-            let mut s = 0.0f32;
-            for &(lo, hi) in &fr[..n] {
-                for j in lo as usize..hi as usize {
-                    let mut r2 = 0.0f32;
-                    let mut vr = 0.0f32;
-                    for d in 0..D {
-                        let dx = xb[d] - fluid.x[d][j];
-                        r2 += dx * dx;
-                        vr -= fluid.v[d][j] * dx;
-                    }
-                    if r2 < c.support2 {
-                        s += vr * k.grad_factor(r2.sqrt());
+    drho.par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(ci, chunk)| {
+            let mut fr: Ranges = NO_RANGES;
+            for (o, out) in chunk.iter_mut().enumerate() {
+                let b = ci * CHUNK + o;
+                let xb: [f32; D] = std::array::from_fn(|d| bx[d][b]);
+                let n = grid.ranges(bcell[b], &fluid.starts, &mut fr);
+                let mut s = 0.0f32;
+                for &(lo, hi) in &fr[..n] {
+                    for j in lo as usize..hi as usize {
+                        let mut r2 = 0.0f32;
+                        let mut vr = 0.0f32;
+                        for d in 0..D {
+                            let dx = xb[d] - fluid.x[d][j];
+                            r2 += dx * dx;
+                            vr -= fluid.v[d][j] * dx;
+                        }
+                        if r2 < c.support2 {
+                            s += vr * k.grad_factor(r2.sqrt());
+                        }
                     }
                 }
+                *out = c.m_fluid * s;
             }
-            *out = c.m_fluid * s;
-        }
-    });
+        });
 }

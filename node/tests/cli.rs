@@ -1,0 +1,208 @@
+//! End to end: the `slosh` binary as a user runs it.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn slosh() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_slosh"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("slosh-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn csv(path: &PathBuf) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn run_writes_the_documented_outputs() {
+    let out = tmp("run");
+    let st = slosh()
+        .args(["run", "../launch-configs/seed_tank_019.yaml", "--out"])
+        .arg(&out)
+        .args([
+            "--duration",
+            "0.2",
+            "--set",
+            "dimension=2",
+            "--set",
+            "particle_spacing=0.02",
+            "--set",
+            "output_rate_hz=20",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    assert!(String::from_utf8_lossy(&st.stdout).contains(&out.display().to_string()));
+    let (h, rows) = csv(&out.join("probes.csv"));
+    assert_eq!(h, ["time", "p25", "p180"]);
+    assert_eq!(rows.len(), 5, "rows at 0, 0.05, ..., 0.2 s");
+    assert!(
+        rows.iter()
+            .all(|r| (r[1] - 0.19).abs() < 0.02 && (r[2] - 0.19).abs() < 0.02),
+        "{rows:?}"
+    );
+    let (h, rows) = csv(&out.join("wrench.csv"));
+    assert_eq!(h, ["time", "fx", "fy", "fz", "mx", "my", "mz"]);
+    // Liquid weight 0.8 x 0.25 x 0.19 x 1000 x 9.81 = 372.8 N, downwards (the first row is the initial state).
+    let fz = rows.last().unwrap()[3];
+    assert!((fz + 372.8).abs() < 0.05 * 372.8, "fz {fz}");
+    let (h, _) = csv(&out.join("pressure.csv"));
+    assert_eq!(h, ["time", "wall_left_0.10", "wall_right_0.10"]);
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for k in [
+        "dimension",
+        "particles_fluid",
+        "particles_boundary",
+        "steps",
+        "sim_time_s",
+        "wall_time_s",
+        "realtime_factor",
+        "particle_steps_per_s",
+    ] {
+        assert!(s.get(k).is_some(), "summary lacks {k}");
+    }
+    assert_eq!(s["dimension"], 2);
+    assert!(s["sim_time_s"].as_f64().unwrap() >= 0.2);
+    assert!(s["error"].is_null());
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn bad_parameters_fail_with_the_key_named() {
+    let out = tmp("bad");
+    let o = slosh()
+        .args(["run", "../launch-configs/seed_tank_039.yaml", "--out"])
+        .arg(&out)
+        .args(["--set", "solver.kernel=gaussian"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("solver.kernel") && e.contains("cubic_spline") && e.contains("wendland"),
+        "{e}"
+    );
+    let o = slosh()
+        .args(["run", "no_such_case", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("built-in cases"));
+}
+
+#[test]
+fn csv_motion_drives_the_tank_and_bad_rows_are_reported_by_line() {
+    let dir = tmp("csv");
+    std::fs::create_dir_all(&dir).unwrap();
+    // Sway at 1 Hz, 1 cm, sampled at 100 Hz, far from the world origin.
+    let mut text = String::from("time,x,y,z,roll,pitch,yaw\n");
+    for i in 0..=100 {
+        let t = i as f64 * 0.01;
+        text += &format!(
+            "{t},{},2000.0,0.0,0.0,0.0,0.0\n",
+            1000.0 + 0.01 * (2.0 * std::f64::consts::PI * t).sin()
+        );
+    }
+    std::fs::write(dir.join("motion.csv"), &text).unwrap();
+    let cfg = "slosh:\n  ros__parameters:\n    dimension: 2\n    tank: {length: 0.4, breadth: 0.1, height: 0.3}\n    fill_height: 0.1\n    particle_spacing: 0.02\n    motion: {source: csv, file: motion.csv}\n";
+    std::fs::write(dir.join("case.yaml"), cfg).unwrap();
+    let o = slosh()
+        .arg("run")
+        .arg(dir.join("case.yaml"))
+        .arg("--out")
+        .arg(dir.join("out"))
+        .args(["--duration", "0.5"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, rows) = csv(&dir.join("out/wrench.csv"));
+    // The sway accelerates the liquid: a horizontal force appears.
+    assert!(rows.iter().any(|r| r[1].abs() > 0.5), "no horizontal force");
+    // Asking for more than the motion covers is refused up front.
+    let o = slosh()
+        .arg("run")
+        .arg(dir.join("case.yaml"))
+        .arg("--out")
+        .arg(dir.join("out2"))
+        .args(["--duration", "2"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("motion ends at t = 1 s"));
+    // A duplicated time stamp is reported with its line.
+    std::fs::write(dir.join("motion.csv"), text.replace("0.05,", "0.04,")).unwrap();
+    let o = slosh()
+        .arg("run")
+        .arg(dir.join("case.yaml"))
+        .arg("--out")
+        .arg(dir.join("out3"))
+        .args(["--duration", "0.5"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("motion.csv: line 7") && e.contains("times must increase"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_solver_failure_keeps_the_outputs_written_so_far() {
+    let out = tmp("fail");
+    // A violent shake with a far too large Courant number: the run blows up, and says so.
+    let o = slosh()
+        .args(["run", "../launch-configs/seed_tank_019.yaml", "--out"])
+        .arg(&out)
+        .args([
+            "--duration",
+            "3",
+            "--set",
+            "dimension=2",
+            "--set",
+            "particle_spacing=0.02",
+            "--set",
+            "solver.cfl=1.0",
+            "--set",
+            "solver.dt_max=0.01",
+        ])
+        .args([
+            "--set",
+            "motion.source=regular",
+            "--set",
+            "motion.regular.amplitude=[0.3,0,0,0,0.3,0]",
+            "--set",
+            "motion.regular.period=[0.3,0,0,0,0.3,0]",
+        ])
+        .output()
+        .unwrap();
+    assert!(!o.status.success(), "expected a failure");
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("solver stopped") && e.contains("outputs up to t ="),
+        "{e}"
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(s["error"].is_string());
+    let (_, rows) = csv(&out.join("probes.csv"));
+    assert!(!rows.is_empty());
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -1,0 +1,172 @@
+//! Validation against experiments, from the data files in `../shared/validation/` (not shipped with the
+//! project). Run with `cargo test --release -p slosh-tests --features validation`; the directory can be
+//! moved with SLOSH_VALIDATION_DIR. A missing file is a failure, never a skip.
+#![cfg(feature = "validation")]
+// Component loops over the const-generic dimension read as the formulas do; `!(x >= 0.0)` is used on purpose
+// to catch NaN along with negatives.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+
+use slosh_node::config;
+use sph::motion::{SampledMotion, TankMotion};
+use std::path::PathBuf;
+
+fn data_dir() -> PathBuf {
+    std::env::var("SLOSH_VALIDATION_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/validation")
+        })
+}
+
+fn read(rel: &str) -> String {
+    let p = data_dir().join(rel);
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("validation data {} is missing ({e}); set SLOSH_VALIDATION_DIR to the shared/validation folder", p.display()))
+}
+
+/// Numbers of a whitespace/comma/semicolon-separated table, skipping lines that do not parse.
+fn table(text: &str) -> Vec<Vec<f64>> {
+    text.lines()
+        .filter_map(|l| {
+            let v: Result<Vec<f64>, _> = l
+                .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+                .filter(|s| !s.is_empty())
+                .map(str::parse)
+                .collect();
+            v.ok().filter(|v| !v.is_empty())
+        })
+        .collect()
+}
+
+fn interp(t: &[f64], y: &[f64], x: f64) -> f64 {
+    let i = t.partition_point(|&v| v <= x).clamp(1, t.len() - 1);
+    let w = (x - t[i - 1]) / (t[i] - t[i - 1]);
+    y[i - 1] + w * (y[i] - y[i - 1])
+}
+
+/// Runs a built-in case with overrides under `motion`, recording (time, probe 0, sensor 0) every `every` s.
+fn run(
+    case: &str,
+    overrides: &[&str],
+    motion: &dyn TankMotion,
+    t_end: f64,
+    every: f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let cfg = config::load(case, &o).unwrap();
+    let mut sim = sph::build(cfg.sim_params().unwrap()).unwrap();
+    let (mut t, mut probe, mut press) = (vec![], vec![], vec![]);
+    let mut k = 0;
+    while sim.time() < t_end {
+        sim.advance_to(motion, k as f64 * every).unwrap();
+        let ob = sim.observe(motion).unwrap();
+        t.push(ob.time);
+        probe.push(ob.probes[0]);
+        press.push(ob.pressures[0]);
+        k += 1;
+    }
+    (t, probe, press)
+}
+
+#[test]
+#[ignore = "known gap, issue 2: at dp = 20 mm the simulated near-wall peak is 0.196 m against the measured 0.142 m (rms error 48 %)"]
+fn faltinsen_2000_forced_sway_elevation_near_the_wall() {
+    let exp = table(&read(
+        "faltinsen2000_sway/faltinsen_etal_2000_fig7_h0.6_T1.3.csv",
+    ));
+    assert!(exp.len() > 150, "expected the 170 digitised points");
+    let cfg = config::load("faltinsen2000_sway", &[]).unwrap();
+    let motion = slosh_node::motion_source::build(&cfg).unwrap();
+    let t_end = 7.0;
+    let (t, probe, _) = run(
+        "faltinsen2000_sway",
+        &["particle_spacing=0.02"],
+        motion.as_ref(),
+        t_end,
+        0.02,
+    );
+    let eta: Vec<f64> = probe.iter().map(|p| p - 0.6).collect();
+    let pts: Vec<&Vec<f64>> = exp.iter().filter(|r| r[0] <= t_end).collect();
+    let rms = |f: &dyn Fn(&Vec<f64>) -> f64| {
+        (pts.iter().map(|r| f(r).powi(2)).sum::<f64>() / pts.len() as f64).sqrt()
+    };
+    let rms_exp = rms(&|r| r[1]);
+    let rms_err = rms(&|r| interp(&t, &eta, r[0]) - r[1]);
+    let max_exp = pts.iter().map(|r| r[1].abs()).fold(0.0, f64::max);
+    let max_sim = eta.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    eprintln!("Faltinsen 2000: rms elevation {rms_exp:.4} m, rms error {rms_err:.4} m ({:.0} %), peak {max_exp:.4} m vs {max_sim:.4} m", 100.0 * rms_err / rms_exp);
+    assert!(
+        rms_err < 0.5 * rms_exp,
+        "rms error {rms_err} vs rms elevation {rms_exp}"
+    );
+    assert!(
+        (max_sim - max_exp).abs() < 0.3 * max_exp,
+        "peak {max_sim} vs {max_exp}"
+    );
+}
+
+#[test]
+fn spheric10_sensor1_impacts_come_at_the_measured_times() {
+    let rows = table(&read("spheric10_dualsphysics/CaseSloshingMotionData.dat"));
+    // The measured roll law (degrees) turns the tank about its y axis: pitch in the tank frame.
+    // 20 kHz: keep every 20th sample (1 kHz) for the spline.
+    // The file's positive angle turns the tank the other way round +y than our pitch does: with the angle
+    // as given, the first impact is on the right wall; negated, it is on the left wall at 2.38 s as measured.
+    let sign = -1.0;
+    let (times, poses): (Vec<f64>, Vec<[f64; 6]>) = rows
+        .iter()
+        .step_by(20)
+        .map(|r| (r[0], [0.0, 0.0, 0.0, 0.0, sign * r[1].to_radians(), 0.0]))
+        .unzip();
+    let motion = SampledMotion::new(times, &poses).unwrap();
+    let mut exp = table(&read(
+        "spheric10_dualsphysics/EXP_Pressure_SPHERIC_Benchmark10.txt",
+    ));
+    exp.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let t_end = 6.0;
+    let (t, _, p) = run(
+        "spheric10",
+        &[
+            "particle_spacing=0.008",
+            "motion.source=none",
+            "solver.boundary.method=mirror",
+        ],
+        &motion,
+        t_end,
+        0.002,
+    );
+    let mut peaks: Vec<(f64, f64)> = vec![];
+    for i in 1..p.len().saturating_sub(1) {
+        if p[i] > 500.0
+            && p[i] >= p[i - 1]
+            && p[i] >= p[i + 1]
+            && peaks.last().map(|q| t[i] - q.0 > 0.3).unwrap_or(true)
+        {
+            peaks.push((t[i], p[i]));
+        }
+    }
+    eprintln!("SPHERIC 10 simulated peaks over 500 Pa (t, Pa): {peaks:.3?}");
+    for &t_peak in &[2.375, 4.067, 5.672] {
+        let window = |lo: f64, hi: f64| {
+            t.iter()
+                .zip(&p)
+                .filter(|(x, _)| **x >= lo && **x <= hi)
+                .map(|(x, y)| (*x, *y))
+                .fold((0.0, f64::MIN), |a, b| if b.1 > a.1 { b } else { a })
+        };
+        let (ts, ps) = window(t_peak - 0.3, t_peak + 0.3);
+        let pe = exp
+            .iter()
+            .filter(|r| (r[0] - t_peak).abs() < 0.3)
+            .map(|r| r[1])
+            .fold(f64::MIN, f64::max);
+        eprintln!("SPHERIC 10 impact near {t_peak} s: simulated peak {ps:.0} Pa at {ts:.3} s, measured {pe:.0} Pa");
+        assert!(
+            (ts - t_peak).abs() < 0.1,
+            "simulated impact at {ts} s, measured at {t_peak} s"
+        );
+        assert!(
+            ps > pe / 4.0 && ps < pe * 4.0,
+            "simulated peak {ps} Pa, measured {pe} Pa"
+        );
+    }
+}
