@@ -337,6 +337,23 @@ fn key_err(src: &str, key: &str, message: impl Into<String>) -> ConfigError {
     }
 }
 
+/// Rejects a non-positive period (`key` names the periods) for any DOF whose amplitude is not zero.
+fn periods_where_moving(
+    src: &str,
+    key: &str,
+    amplitude: &[f64; 6],
+    period: &[f64; 6],
+) -> Result<(), ConfigError> {
+    match (0..6).find(|&i| amplitude[i] != 0.0 && period[i] <= 0.0) {
+        Some(i) => Err(key_err(
+            src,
+            key,
+            format!("element {i} must be positive where the amplitude is not zero"),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Six values per DOF, or none (all zero).
 fn six(src: &str, key: &str, v: &[f64]) -> Result<[f64; 6], ConfigError> {
     match v.len() {
@@ -442,22 +459,12 @@ impl Loaded {
         let a = six(src, "motion.regular.amplitude", &r.amplitude)?;
         let t = six(src, "motion.regular.period", &r.period)?;
         let ph = six(src, "motion.regular.phase", &r.phase)?;
-        let mut out = [RegularDof::default(); 6];
-        for i in 0..6 {
-            if a[i] != 0.0 && t[i] <= 0.0 {
-                return Err(key_err(
-                    src,
-                    "motion.regular.period",
-                    format!("element {i} must be positive where the amplitude is not zero"),
-                ));
-            }
-            out[i] = RegularDof {
-                amplitude: a[i],
-                period: t[i],
-                phase: ph[i],
-            };
-        }
-        Ok(out)
+        periods_where_moving(src, "motion.regular.period", &a, &t)?;
+        Ok(std::array::from_fn(|i| RegularDof {
+            amplitude: a[i],
+            period: t[i],
+            phase: ph[i],
+        }))
     }
 
     /// Irregular motion per DOF.
@@ -470,20 +477,11 @@ impl Loaded {
             &r.significant_amplitude,
         )?;
         let t = six(src, "motion.irregular.peak_period", &r.peak_period)?;
-        let mut out = [JonswapDof::default(); 6];
-        for i in 0..6 {
-            if a[i] != 0.0 && t[i] <= 0.0 {
-                return Err(key_err(
-                    src,
-                    "motion.irregular.peak_period",
-                    format!("element {i} must be positive where the amplitude is not zero"),
-                ));
-            }
-            out[i] = JonswapDof {
-                significant_amplitude: a[i],
-                peak_period: t[i],
-            };
-        }
+        periods_where_moving(src, "motion.irregular.peak_period", &a, &t)?;
+        let out = std::array::from_fn(|i| JonswapDof {
+            significant_amplitude: a[i],
+            peak_period: t[i],
+        });
         if !(r.gamma >= 1.0) {
             return Err(key_err(
                 src,

@@ -4,7 +4,7 @@
 //! steps of a quarter spacing and the crossing is interpolated linearly.
 
 use crate::kernel::Kernel;
-use crate::neighbours::{Grid, Ranges, NO_RANGES};
+use crate::neighbours::Grid;
 use crate::particles::{Boundary, Fluid};
 
 /// Static lattice of wall points used to normalise the liquid fraction near walls.
@@ -22,35 +22,14 @@ pub fn fraction<const D: usize, K: Kernel>(
     shell: &Shell<D>,
     p: [f64; D],
 ) -> f32 {
-    let mut ranges: Ranges = NO_RANGES;
-    let s2 = k.support() * k.support();
-    let pf: [f32; D] = std::array::from_fn(|d| p[d] as f32);
-    let sum =
-        |x: &[Vec<f32>; D], starts: &[u32], weight: &dyn Fn(usize) -> f32, ranges: &mut Ranges| {
-            let n = grid.ranges_around(p, starts, ranges);
-            let mut s = 0.0f32;
-            for &(lo, hi) in &ranges[..n] {
-                for j in lo as usize..hi as usize {
-                    let r2: f32 = (0..D).map(|d| (pf[d] - x[d][j]).powi(2)).sum();
-                    if r2 < s2 {
-                        s += weight(j) * k.w(r2.sqrt());
-                    }
-                }
-            }
-            s
-        };
-    let liquid = sum(
-        &fluid.x,
-        &fluid.starts,
-        &|j| m_fluid / fluid.r[j],
-        &mut ranges,
-    );
-    let wall = sum(
-        &shell.points.x,
-        &shell.points.starts,
-        &|_| shell.volume,
-        &mut ranges,
-    );
+    let mut liquid = 0.0f32;
+    super::for_each_in_reach(k, grid, &fluid.x, &fluid.starts, p, |j, w| {
+        liquid += m_fluid / fluid.r[j] * w
+    });
+    let mut wall = 0.0f32;
+    super::for_each_in_reach(k, grid, &shell.points.x, &shell.points.starts, p, |_, w| {
+        wall += shell.volume * w
+    });
     liquid / (1.0 - wall).max(0.25)
 }
 
