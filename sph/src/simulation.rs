@@ -56,7 +56,7 @@ pub struct Simulation<const D: usize, K: Kernel> {
     last: PassTotals,
     rates_current: bool,
     scratch: SortScratch,
-    partials: Vec<PassTotals>,
+    work: wcsph::Workspace<D>,
 }
 
 impl<const D: usize, K: Kernel> Simulation<D, K> {
@@ -158,7 +158,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             last: PassTotals::default(),
             rates_current: false,
             scratch,
-            partials: Vec::new(),
+            work: Default::default(),
         })
     }
 
@@ -206,7 +206,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             &frame,
             &mut self.fluid,
             &self.bound,
-            &mut self.partials,
+            &mut self.work,
         );
         if self.params.solver.boundary.method == BoundaryMethod::Dynamic {
             wcsph::wall_density_rates(

@@ -48,13 +48,14 @@ impl Kernel for CubicSpline {
         // dW/dr = norm/h * dW/dq; divided by r = q h.
         let q = r * self.inv_h;
         let s = self.norm * self.inv_h * self.inv_h;
+        // Both branches are computed and one selected, so the pair loop stays branch-free and vectorises.
+        let t = (2.0 - q).max(0.0);
+        let outer = -s * 0.75 * t * t / q.max(1.0);
+        let inner = s * (-3.0 + 2.25 * q);
         if q < 1.0 {
-            s * (-3.0 + 2.25 * q)
-        } else if q < 2.0 {
-            let t = 2.0 - q;
-            -s * 0.75 * t * t / q
+            inner
         } else {
-            0.0
+            outer
         }
     }
 }

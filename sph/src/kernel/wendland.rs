@@ -43,12 +43,8 @@ impl Kernel for WendlandC2 {
     #[inline(always)]
     fn grad_factor(&self, r: f32) -> f32 {
         // dW/dq = -5 q (1 - q/2)^3 ; dW/dr / r = norm * (-5 (1-q/2)^3) / h^2
-        let q = r * self.inv_h;
-        if q < 2.0 {
-            let t = 1.0 - 0.5 * q;
-            -5.0 * self.norm * t * t * t * self.inv_h * self.inv_h
-        } else {
-            0.0
-        }
+        // Branch-free (t clamps to 0 beyond the support) so the pair loop vectorises.
+        let t = (1.0 - 0.5 * r * self.inv_h).max(0.0);
+        -5.0 * self.norm * t * t * t * self.inv_h * self.inv_h
     }
 }

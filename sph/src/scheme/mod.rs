@@ -1,6 +1,7 @@
 //! Pressure schemes. Each scheme evaluates the rates of change of the liquid (and of the wall particles'
 //! density) from the current state; the integrator and the simulation are shared.
 
+pub mod candidates;
 pub mod wcsph;
 
 /// The tank frame's motion as the particles feel it, in the tank frame (x, y, z).
