@@ -175,6 +175,116 @@ pub struct RunConfig {
     pub duration: f64,
     #[serde(default)]
     pub motion: MotionCfg,
+    /// The ROS 2 node's motion input (`slosh node`).
+    #[serde(default)]
+    pub input: InputCfg,
+    /// Frame names and the tank's pose on the vessel (`slosh node`).
+    #[serde(default)]
+    pub frames: FramesCfg,
+    /// Pacing of `slosh node`.
+    #[serde(default)]
+    pub realtime: RealtimeCfg,
+    /// s without motion input before the node holds the last pose and reports an error (`slosh node`).
+    #[serde(default = "default_timeout")]
+    pub motion_timeout_s: f64,
+    /// Diagnostics messages per wall-clock second (`slosh node`).
+    #[serde(default = "default_diag_rate")]
+    pub diagnostics_rate_hz: f64,
+}
+
+fn default_timeout() -> f64 {
+    1.0
+}
+fn default_diag_rate() -> f64 {
+    1.0
+}
+
+/// Which message drives the tank in `slosh node`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InputType {
+    /// nav_msgs/Odometry on `motion/odom`.
+    #[default]
+    Odom,
+    /// geometry_msgs/PoseStamped on `motion/pose`.
+    Pose,
+}
+
+/// Motion input of the ROS 2 node.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InputCfg {
+    #[serde(rename = "type")]
+    pub kind: InputType,
+    pub world_frame: crate::ros::frames::WorldFrame,
+    pub body_frame: crate::ros::frames::BodyFrame,
+    /// The solver stays this many sample intervals behind the newest sample (0 = right up to it).
+    pub delay_samples: usize,
+    /// m/s: a sample implying a faster move than this from the previous one is rejected as a jump.
+    pub max_speed: f64,
+    /// rad/s: likewise for each angle.
+    pub max_rotation_rate: f64,
+    /// Take sample times from the header stamp (`header`) or from the arrival time (`receive`).
+    pub stamp: StampSource,
+}
+
+impl Default for InputCfg {
+    fn default() -> Self {
+        Self {
+            kind: InputType::Odom,
+            world_frame: Default::default(),
+            body_frame: Default::default(),
+            delay_samples: 2,
+            max_speed: 50.0,
+            max_rotation_rate: 5.0,
+            stamp: StampSource::Header,
+        }
+    }
+}
+
+/// Where a sample's time comes from.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StampSource {
+    #[default]
+    Header,
+    Receive,
+}
+
+/// Frame names in the node's messages, and where the tank sits on the vessel.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FramesCfg {
+    pub vessel: String,
+    pub tank: String,
+    pub tank_pose: crate::ros::frames::TankPose,
+}
+
+impl Default for FramesCfg {
+    fn default() -> Self {
+        Self {
+            vessel: "base_link".into(),
+            tank: "tank".into(),
+            tank_pose: Default::default(),
+        }
+    }
+}
+
+/// How `slosh node` paces the simulation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RealtimeMode {
+    /// Keep up with the incoming motion in wall-clock time; hold the last pose when input stops.
+    #[default]
+    Realtime,
+    /// As fast as the input allows, publishing `/clock` (CI, replay).
+    Lockstep,
+}
+
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RealtimeCfg {
+    pub mode: RealtimeMode,
 }
 
 /// A loaded configuration: the typed parameters, where they came from, and the merged parameter tree.

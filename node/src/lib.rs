@@ -1,5 +1,5 @@
 //! The `slosh` command's library: configuration, motion sources, the offline runner, outputs and benchmarks.
-//! The ROS 2 node will live here too; the binary stays a thin layer over these modules.
+//! and the ROS 2 node and motion publisher (`ros`); the binary stays a thin layer over these modules.
 // Component loops over the const-generic dimension read as the formulas do; `!(x >= 0.0)` is used on purpose
 // to catch NaN along with negatives.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
@@ -8,4 +8,5 @@ pub mod bench;
 pub mod config;
 pub mod motion_source;
 pub mod output;
+pub mod ros;
 pub mod runner;

@@ -1,6 +1,6 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use slosh_node::{bench, config, runner};
+use slosh_node::{bench, config, ros, runner};
 use std::path::PathBuf;
 
 /// Sloshing of a liquid in a moving tank, by SPH.
@@ -39,11 +39,88 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Run as a ROS 2 node: `slosh node --ros-args --params-file CASE.yaml [-p name:=value] [-r from:=to]`.
+    Node {
+        /// Stop after this many simulated seconds (default: run until SIGINT/SIGTERM).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// ROS arguments (`--ros-args ...`); a plain first argument names the parameters file or built-in case.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// Publish synthetic vessel motion (the config's `motion.*`) as nav_msgs/Odometry on `motion/odom`.
+    Motion {
+        /// Config file or built-in case whose `motion.*` parameters give the motion.
+        config: String,
+        /// Samples per second.
+        #[arg(long, default_value_t = 50.0)]
+        rate: f64,
+        /// Seconds of motion.
+        #[arg(long, default_value_t = 10.0)]
+        duration: f64,
+        /// Also publish geometry_msgs/PoseStamped on `motion/pose`.
+        #[arg(long)]
+        pose: bool,
+        /// Wait for this many subscribers on `motion/odom` before the first sample.
+        #[arg(long, default_value_t = 0)]
+        wait_for_subscribers: usize,
+        /// Stay a few samples ahead of the simulation's `/clock` instead of pacing by the wall clock
+        /// (for `realtime.mode: lockstep`).
+        #[arg(long)]
+        lockstep: bool,
+        /// Stamp of the first sample in seconds since the epoch (default: now).
+        #[arg(long)]
+        start_stamp: Option<f64>,
+        /// ROS arguments (`--ros-args -r __ns:=/ship1 ...`).
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
 }
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Node { duration, args } => {
+            let (plain, ros_args) = ros::args::parse(&args)?;
+            if plain.len() > 1 {
+                anyhow::bail!(
+                    "unexpected arguments {:?}: ROS arguments go after --ros-args",
+                    &plain[1..]
+                );
+            }
+            ros::node::run(
+                &ros_args,
+                plain.first().map(String::as_str),
+                &ros::node::NodeOptionsCli { duration },
+            )?;
+        }
+        Command::Motion {
+            config: cfg,
+            rate,
+            duration,
+            pose,
+            wait_for_subscribers,
+            lockstep,
+            start_stamp,
+            args,
+        } => {
+            let (plain, ros_args) = ros::args::parse(&args)?;
+            if !plain.is_empty() {
+                anyhow::bail!("unexpected arguments {plain:?}: ROS arguments go after --ros-args");
+            }
+            ros::motion_pub::run(
+                &ros_args,
+                &cfg,
+                &ros::motion_pub::MotionOptions {
+                    rate_hz: rate,
+                    duration,
+                    pose,
+                    wait_for_subscribers,
+                    lockstep,
+                    start_stamp,
+                },
+            )?;
+        }
         Command::Run {
             config: cfg,
             out,

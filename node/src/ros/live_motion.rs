@@ -1,0 +1,233 @@
+//! Motion received sample by sample. Samples are checked (finite, in order, no duplicates, no jumps) and
+//! interpolated by a cubic spline over a sliding window; the solver is never run past the newest sample it
+//! has, less a small delay so that the spline's free end does not bias the accelerations it sees.
+
+use sph::motion::{Dof6Motion, RigidState, SampledMotion, TankMotion};
+use std::collections::VecDeque;
+use std::f64::consts::PI;
+
+/// Samples kept for interpolation.
+const WINDOW: usize = 24;
+
+/// Why a sample was dropped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Rejected {
+    #[error("{what} is not a finite number")]
+    NotFinite { what: &'static str },
+    #[error("stamp {time:.6} s is older than the newest sample's {newest:.6} s (out of order)")]
+    OutOfOrder { time: f64, newest: f64 },
+    #[error("stamp {time:.6} s repeats the newest sample's (duplicate)")]
+    Duplicate { time: f64 },
+    #[error("{what} jumps by {size:.3} in {dt:.4} s, faster than the limit {limit} (input.max_speed / input.max_rotation_rate)")]
+    Jump {
+        what: &'static str,
+        size: f64,
+        dt: f64,
+        limit: f64,
+    },
+}
+
+/// Plausibility limits of incoming samples.
+#[derive(Debug, Clone, Copy)]
+pub struct Limits {
+    /// m/s between consecutive samples.
+    pub max_speed: f64,
+    /// rad/s between consecutive samples.
+    pub max_rotation_rate: f64,
+}
+
+/// Tank poses received so far (times relative to the first sample), as a [`TankMotion`].
+#[derive(Debug)]
+pub struct LiveMotion {
+    limits: Limits,
+    times: VecDeque<f64>,
+    poses: VecDeque<[f64; 6]>,
+    spline: Option<SampledMotion>,
+}
+
+const NAMES: [&str; 6] = ["x", "y", "z", "roll", "pitch", "yaw"];
+
+impl LiveMotion {
+    pub fn new(limits: Limits) -> Self {
+        Self {
+            limits,
+            times: VecDeque::with_capacity(WINDOW + 1),
+            poses: VecDeque::with_capacity(WINDOW + 1),
+            spline: None,
+        }
+    }
+
+    /// Adds a tank pose (x, y, z, roll, pitch, yaw) at time `t`, or says why not.
+    pub fn push(&mut self, t: f64, pose: [f64; 6]) -> Result<(), Rejected> {
+        if !t.is_finite() {
+            return Err(Rejected::NotFinite { what: "time" });
+        }
+        if let Some(k) = pose.iter().position(|v| !v.is_finite()) {
+            return Err(Rejected::NotFinite { what: NAMES[k] });
+        }
+        if let (Some(&t0), Some(p0)) = (self.times.back(), self.poses.back()) {
+            if t == t0 {
+                return Err(Rejected::Duplicate { time: t });
+            }
+            if t < t0 {
+                return Err(Rejected::OutOfOrder {
+                    time: t,
+                    newest: t0,
+                });
+            }
+            let dt = t - t0;
+            let dist =
+                ((pose[0] - p0[0]).powi(2) + (pose[1] - p0[1]).powi(2) + (pose[2] - p0[2]).powi(2))
+                    .sqrt();
+            if dist > self.limits.max_speed * dt {
+                return Err(Rejected::Jump {
+                    what: "position (m)",
+                    size: dist,
+                    dt,
+                    limit: self.limits.max_speed,
+                });
+            }
+            for k in 3..6 {
+                let d = pose[k] - p0[k];
+                let d = (d - (d / (2.0 * PI)).round() * 2.0 * PI).abs();
+                if d > self.limits.max_rotation_rate * dt {
+                    return Err(Rejected::Jump {
+                        what: NAMES[k],
+                        size: d,
+                        dt,
+                        limit: self.limits.max_rotation_rate,
+                    });
+                }
+            }
+        }
+        self.times.push_back(t);
+        self.poses.push_back(pose);
+        while self.times.len() > WINDOW {
+            self.times.pop_front();
+            self.poses.pop_front();
+        }
+        self.spline = if self.times.len() >= 2 {
+            let poses: Vec<[f64; 6]> = self.poses.iter().copied().collect();
+            SampledMotion::new(self.times.iter().copied().collect(), &poses).ok()
+        } else {
+            None
+        };
+        Ok(())
+    }
+
+    /// Time of the newest sample.
+    pub fn newest(&self) -> Option<f64> {
+        self.times.back().copied()
+    }
+
+    /// The newest pose.
+    pub fn last_pose(&self) -> Option<[f64; 6]> {
+        self.poses.back().copied()
+    }
+
+    /// How far the solver may go: the newest sample less `delay_samples` sample intervals (None until two
+    /// samples are in).
+    pub fn safe_until(&self, delay_samples: usize) -> Option<f64> {
+        let n = self.times.len();
+        if n < 2 {
+            return None;
+        }
+        let k = delay_samples.min(n - 2);
+        Some(self.times[n - 1 - k])
+    }
+
+    pub fn samples(&self) -> usize {
+        self.times.len()
+    }
+}
+
+impl TankMotion for LiveMotion {
+    fn state(&self, t: f64) -> RigidState {
+        match &self.spline {
+            Some(s) => s.dof(t).to_state(),
+            None => match self.poses.back() {
+                Some(p) => sph::motion::Dof6 {
+                    q: *p,
+                    ..Default::default()
+                }
+                .to_state(),
+                None => RigidState::at_rest(),
+            },
+        }
+    }
+
+    fn end_time(&self) -> f64 {
+        self.newest().unwrap_or(0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn limits() -> Limits {
+        Limits {
+            max_speed: 20.0,
+            max_rotation_rate: 3.0,
+        }
+    }
+
+    #[test]
+    fn rejects_bad_samples_with_reasons_and_keeps_the_good_ones() {
+        let mut m = LiveMotion::new(limits());
+        m.push(0.0, [0.0; 6]).unwrap();
+        assert_eq!(
+            m.push(0.1, [f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            Err(Rejected::NotFinite { what: "x" })
+        );
+        m.push(0.1, [0.1, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+        assert!(matches!(
+            m.push(0.1, [0.1; 6]),
+            Err(Rejected::Duplicate { .. })
+        ));
+        assert!(matches!(
+            m.push(0.05, [0.1; 6]),
+            Err(Rejected::OutOfOrder { .. })
+        ));
+        assert!(matches!(
+            m.push(0.2, [5.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            Err(Rejected::Jump {
+                what: "position (m)",
+                ..
+            })
+        ));
+        assert!(matches!(
+            m.push(0.2, [0.2, 0.0, 0.0, 0.0, 0.0, 1.0]),
+            Err(Rejected::Jump { what: "yaw", .. })
+        ));
+        // Yaw wrapping through ±π is not a jump.
+        let mut w = LiveMotion::new(limits());
+        w.push(0.0, [0.0, 0.0, 0.0, 0.0, 0.0, PI - 0.01]).unwrap();
+        w.push(0.1, [0.0, 0.0, 0.0, 0.0, 0.0, -PI + 0.01]).unwrap();
+        assert_eq!(m.samples(), 2);
+        assert_eq!(m.newest(), Some(0.1));
+    }
+
+    #[test]
+    fn interpolates_a_sampled_sinusoid_with_its_acceleration() {
+        let mut m = LiveMotion::new(limits());
+        let (a, w) = (0.05, 2.0 * PI / 1.2);
+        for i in 0..200 {
+            let t = i as f64 * 0.01;
+            m.push(t, [a * (w * t).sin(), 0.0, 0.0, 0.0, 0.0, 0.0])
+                .unwrap();
+        }
+        assert_eq!(m.samples(), WINDOW);
+        let until = m.safe_until(3).unwrap();
+        assert!((until - 1.96).abs() < 1e-9);
+        let t = until - 0.005;
+        let s = m.state(t);
+        let acc = -a * w * w * (w * t).sin();
+        assert!(
+            (s.acceleration.x - acc).abs() < 0.01 * a * w * w,
+            "{} vs {acc}",
+            s.acceleration.x
+        );
+        assert!((s.velocity.x - a * w * (w * t).cos()).abs() < 1e-3 * a * w);
+    }
+}

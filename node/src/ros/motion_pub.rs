@@ -1,0 +1,220 @@
+//! `slosh motion`: publishes synthetic vessel motion (the config's `motion.*`: regular, irregular JONSWAP or a
+//! CSV file) as nav_msgs/Odometry on `motion/odom`, and optionally geometry_msgs/PoseStamped on `motion/pose`,
+//! for headless CI and demos. Paced by the wall clock, or in lockstep with a simulation's `/clock`.
+
+use super::args::{Names, RosArgs};
+use crate::motion_source;
+use nalgebra::UnitQuaternion;
+use ros2_client::qos::{History, WhenFull};
+use ros2_client::{NodeName, NodeOptions, QosProfile};
+use slosh_msgs::builtin_interfaces::Time;
+use slosh_msgs::geometry_msgs::{
+    Point, Pose, PoseStamped, PoseWithCovariance, Quaternion, Twist, TwistWithCovariance, Vector3,
+};
+use slosh_msgs::nav_msgs::Odometry;
+use slosh_msgs::rosgraph_msgs::Clock;
+use slosh_msgs::std_msgs::Header;
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+/// Options of `slosh motion`.
+#[derive(Debug, Clone)]
+pub struct MotionOptions {
+    /// Samples per second.
+    pub rate_hz: f64,
+    /// Seconds of motion to publish.
+    pub duration: f64,
+    /// Also publish PoseStamped on `motion/pose`.
+    pub pose: bool,
+    /// Wait until this many subscribers are on `motion/odom` before the first sample (0: do not wait).
+    pub wait_for_subscribers: usize,
+    /// Publish ahead of a simulation's `/clock` by `lead` samples instead of pacing by the wall clock.
+    pub lockstep: bool,
+    /// Stamp of the first sample, s since the epoch (None: now).
+    pub start_stamp: Option<f64>,
+}
+
+/// The Odometry of the motion at time t (pose in the world, twist in the body frame as REP 105 says).
+pub fn odometry(
+    motion: &dyn sph::motion::TankMotion,
+    t: f64,
+    stamp: Time,
+    world: &str,
+    body: &str,
+) -> Odometry {
+    let s = motion.state(t);
+    let q: UnitQuaternion<f64> = s.orientation;
+    let v_body = q.inverse_transform_vector(&s.velocity);
+    Odometry {
+        header: Header {
+            stamp,
+            frame_id: world.into(),
+        },
+        child_frame_id: body.into(),
+        pose: PoseWithCovariance {
+            pose: Pose {
+                position: Point {
+                    x: s.position.x,
+                    y: s.position.y,
+                    z: s.position.z,
+                },
+                orientation: Quaternion {
+                    x: q.i,
+                    y: q.j,
+                    z: q.k,
+                    w: q.w,
+                },
+            },
+            covariance: [0.0; 36],
+        },
+        twist: TwistWithCovariance {
+            twist: Twist {
+                linear: Vector3 {
+                    x: v_body.x,
+                    y: v_body.y,
+                    z: v_body.z,
+                },
+                angular: Vector3 {
+                    x: s.angular_velocity.x,
+                    y: s.angular_velocity.y,
+                    z: s.angular_velocity.z,
+                },
+            },
+            covariance: [0.0; 36],
+        },
+    }
+}
+
+/// Publishes until the duration is reached or SIGINT/SIGTERM.
+pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<()> {
+    if !(opts.rate_hz.is_finite() && opts.rate_hz > 0.0) {
+        anyhow::bail!(
+            "--rate: must be a positive number of samples per second, got {}",
+            opts.rate_hz
+        );
+    }
+    if !(opts.duration.is_finite() && opts.duration > 0.0) {
+        anyhow::bail!(
+            "--duration: must be a positive number of seconds, got {}",
+            opts.duration
+        );
+    }
+    let cfg = crate::config::load(config, &ros.params)?;
+    let motion = motion_source::build(&cfg)?;
+    if opts.duration > motion.end_time() {
+        anyhow::bail!(
+            "--duration {} s: the motion ends at t = {} s",
+            opts.duration,
+            motion.end_time()
+        );
+    }
+    let names = Names::new(ros, "slosh_motion")?;
+    let stop = super::shutdown_flag()?;
+    let context = super::context()?;
+    let mut node = context
+        .new_node(
+            NodeName::new(&names.namespace, &names.node)
+                .map_err(|e| anyhow::anyhow!("node name: {e:?}"))?,
+            NodeOptions::new().enable_rosout(false),
+        )
+        .map_err(|e| anyhow::anyhow!("cannot create the node: {e:?}"))?;
+    let qos = QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::Wait(Duration::from_millis(20)))
+        .history(History::KeepLast { depth: 5 });
+    let pub_odom = super::publisher::<Odometry>(&mut node, &names, "motion/odom", &qos)?;
+    let pub_pose = if opts.pose {
+        Some(super::publisher::<PoseStamped>(
+            &mut node,
+            &names,
+            "motion/pose",
+            &qos,
+        )?)
+    } else {
+        None
+    };
+    let clock = if opts.lockstep {
+        Some(super::subscription::<Clock>(
+            &mut node,
+            &names,
+            "/clock",
+            &QosProfile::subscription_default().history(History::KeepLast { depth: 5 }),
+        )?)
+    } else {
+        None
+    };
+    let odom_topic = names.resolve("motion/odom")?;
+    if opts.wait_for_subscribers > 0 {
+        eprintln!(
+            "slosh motion: waiting for {} subscriber(s) on {odom_topic}",
+            opts.wait_for_subscribers
+        );
+        while node.subscription_count(&odom_topic) < opts.wait_for_subscribers {
+            if stop.load(Ordering::Relaxed) {
+                return Ok(());
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        // Let the matching finish on both sides before the first sample.
+        std::thread::sleep(Duration::from_millis(500));
+    }
+    let start_stamp = opts.start_stamp.unwrap_or_else(|| {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_secs_f64())
+            .unwrap_or(0.0)
+    });
+    let n = (opts.duration * opts.rate_hz).round() as u64;
+    let lead = 4u64;
+    let mut clock_t = f64::NEG_INFINITY;
+    let start = Instant::now();
+    eprintln!(
+        "slosh motion: publishing {n} samples at {} Hz on {odom_topic}{}",
+        opts.rate_hz,
+        if opts.lockstep {
+            " in lockstep with /clock"
+        } else {
+            ""
+        }
+    );
+    for k in 0..=n {
+        let t = k as f64 / opts.rate_hz;
+        if let Some(sub) = &clock {
+            // Stay `lead` samples ahead of the simulation.
+            while k >= lead && clock_t < t - lead as f64 / opts.rate_hz - 1e-9 {
+                if stop.load(Ordering::Relaxed) {
+                    return Ok(());
+                }
+                match sub.take() {
+                    Ok(Some((c, _))) => clock_t = c.clock.as_secs_f64() - start_stamp,
+                    _ => std::thread::sleep(Duration::from_millis(1)),
+                }
+            }
+        } else {
+            let due = Duration::from_secs_f64(t);
+            let now = start.elapsed();
+            if due > now {
+                std::thread::sleep(due - now);
+            }
+        }
+        if stop.load(Ordering::Relaxed) {
+            break;
+        }
+        let stamp = Time::from_secs_f64(start_stamp + t);
+        let odom = odometry(motion.as_ref(), t, stamp, "odom", "base_link");
+        if let Some(p) = &pub_pose {
+            let ps = PoseStamped {
+                header: odom.header.clone(),
+                pose: odom.pose.pose,
+            };
+            p.publish(ps)
+                .map_err(|e| anyhow::anyhow!("publishing motion/pose: {e:?}"))?;
+        }
+        match pub_odom.publish(odom) {
+            Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => {}
+            Err(e) => anyhow::bail!("publishing motion/odom: {e:?}"),
+        }
+    }
+    // Let reliable readers fetch the last samples.
+    std::thread::sleep(Duration::from_millis(300));
+    Ok(())
+}

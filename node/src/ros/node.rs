@@ -1,0 +1,630 @@
+//! `slosh node`: the solver as a ROS 2 node. Vessel motion in (Odometry or PoseStamped), the liquid's wrench,
+//! probe elevations, wall pressures and diagnostics out, stamped with the simulation time of the state they
+//! describe (the input's time base: output stamp = first input stamp + simulation time).
+
+use super::args::{Names, RosArgs};
+use super::frames::Frames;
+use super::live_motion::{Limits, LiveMotion};
+use super::pacing::Pacing;
+use crate::config::{InputType, Loaded, RealtimeMode, StampSource};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use ros2_client::qos::{Durability, History, WhenFull};
+use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile};
+use slosh_msgs::builtin_interfaces::Time;
+use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
+use slosh_msgs::geometry_msgs::{
+    Point, Pose, PoseStamped, Quaternion as QuatMsg, Transform, TransformStamped,
+    Vector3 as Vec3Msg, Wrench, WrenchStamped,
+};
+use slosh_msgs::nav_msgs::Odometry;
+use slosh_msgs::rosgraph_msgs::Clock;
+use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
+use slosh_msgs::std_msgs::Header;
+use slosh_msgs::tf2_msgs::TFMessage;
+use sph::params::SimParams;
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+/// The node's default name (`-r __node:=...` changes it).
+pub const DEFAULT_NAME: &str = "slosh";
+
+/// Options of `slosh node` besides the parameters.
+#[derive(Debug, Clone, Default)]
+pub struct NodeOptionsCli {
+    /// Stop after this many simulated seconds (None: run until SIGINT/SIGTERM).
+    pub duration: Option<f64>,
+}
+
+/// Loads the parameters the ROS way: `--params-file` files in order (the last file's node section is used
+/// as the base; ROS merges files, we take one and apply `-p` on top), then `-p name:=value`.
+pub fn load_parameters(ros: &RosArgs, fallback: Option<&str>) -> anyhow::Result<Loaded> {
+    let file = match (ros.params_files.last(), fallback) {
+        (Some(f), _) => f.clone(),
+        (None, Some(f)) => f.to_string(),
+        (None, None) => anyhow::bail!(
+            "no parameters: pass --ros-args --params-file launch-configs/<case>.yaml (or a built-in case name)"
+        ),
+    };
+    if ros.params_files.len() > 1 {
+        anyhow::bail!("--params-file: give one parameters file (got {}); override single parameters with -p name:=value", ros.params_files.len());
+    }
+    Ok(crate::config::load(&file, &ros.params)?)
+}
+
+fn qos_outputs() -> QosProfile {
+    QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::Wait(Duration::from_millis(50)))
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 10 })
+}
+
+fn qos_input() -> QosProfile {
+    QosProfile::subscription_default().history(History::KeepLast { depth: 5 })
+}
+
+fn qos_latched() -> QosProfile {
+    QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::Wait(Duration::from_millis(50)))
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast { depth: 1 })
+}
+
+fn header(stamp: Time, frame: &str) -> Header {
+    Header {
+        stamp,
+        frame_id: frame.to_string(),
+    }
+}
+
+fn point(x: f64, y: f64, z: f64) -> Point {
+    Point { x, y, z }
+}
+
+/// Outputs of one observed state as messages.
+pub struct OutputMessages {
+    pub wrench: WrenchStamped,
+    pub probes: ProbeArray,
+    pub pressures: PressureArray,
+}
+
+/// Builds the output messages of an observation at `stamp`.
+pub fn output_messages(
+    params: &SimParams,
+    tank_frame: &str,
+    stamp: Time,
+    o: &sph::observe::Observation,
+) -> OutputMessages {
+    let [fx, fy, fz] = o.wrench.force;
+    let [mx, my, mz] = o.wrench.moment;
+    OutputMessages {
+        wrench: WrenchStamped {
+            header: header(stamp, tank_frame),
+            wrench: Wrench {
+                force: Vec3Msg {
+                    x: fx,
+                    y: fy,
+                    z: fz,
+                },
+                torque: Vec3Msg {
+                    x: mx,
+                    y: my,
+                    z: mz,
+                },
+            },
+        },
+        probes: ProbeArray {
+            header: header(stamp, tank_frame),
+            names: params.probes.iter().map(|p| p.name.clone()).collect(),
+            positions: params.probes.iter().map(|p| point(p.x, p.y, 0.0)).collect(),
+            elevations: o.probes.clone(),
+        },
+        pressures: PressureArray {
+            header: header(stamp, tank_frame),
+            names: params
+                .pressure_sensors
+                .iter()
+                .map(|s| s.name.clone())
+                .collect(),
+            positions: params
+                .pressure_sensors
+                .iter()
+                .map(|s| point(s.x, s.y, s.z))
+                .collect(),
+            pressures: o.pressures.clone(),
+        },
+    }
+}
+
+/// The static transforms vessel → tank → each probe and sensor.
+fn static_transforms(cfg: &Loaded, params: &SimParams, stamp: Time) -> TFMessage {
+    let f = &cfg.config.frames;
+    let tp = f.tank_pose;
+    let q = UnitQuaternion::from_euler_angles(tp.roll, tp.pitch, tp.yaw);
+    let tf = |parent: &str, child: String, t: [f64; 3], q: UnitQuaternion<f64>| TransformStamped {
+        header: header(stamp, parent),
+        child_frame_id: child,
+        transform: Transform {
+            translation: Vec3Msg {
+                x: t[0],
+                y: t[1],
+                z: t[2],
+            },
+            rotation: QuatMsg {
+                x: q.i,
+                y: q.j,
+                z: q.k,
+                w: q.w,
+            },
+        },
+    };
+    let mut transforms = vec![tf(&f.vessel, f.tank.clone(), [tp.x, tp.y, tp.z], q)];
+    for p in &params.probes {
+        transforms.push(tf(
+            &f.tank,
+            format!("{}/probe/{}", f.tank, p.name),
+            [p.x, p.y, 0.0],
+            UnitQuaternion::identity(),
+        ));
+    }
+    for s in &params.pressure_sensors {
+        transforms.push(tf(
+            &f.tank,
+            format!("{}/pressure/{}", f.tank, s.name),
+            [s.x, s.y, s.z],
+            UnitQuaternion::identity(),
+        ));
+    }
+    TFMessage { transforms }
+}
+
+fn pose_of(p: &Pose) -> (Vector3<f64>, UnitQuaternion<f64>) {
+    let o = &p.orientation;
+    let q = Quaternion::new(o.w, o.x, o.y, o.z);
+    // A zero quaternion (an unset orientation) normalises to NaN, which the sample check rejects by name.
+    (
+        Vector3::new(p.position.x, p.position.y, p.position.z),
+        UnitQuaternion::new_unchecked(q / q.norm()),
+    )
+}
+
+/// Counters reported in diagnostics.
+#[derive(Debug, Default, Clone)]
+struct Counters {
+    accepted: u64,
+    rejected: u64,
+    last_reject: String,
+    published: u64,
+    timeouts: u64,
+}
+
+enum Input {
+    Odom(ros2_client::Subscription<Odometry>),
+    Pose(ros2_client::Subscription<PoseStamped>),
+}
+
+impl Input {
+    /// The next received sample: (header stamp, pose).
+    fn take(&self) -> anyhow::Result<Option<(Time, Pose)>> {
+        Ok(match self {
+            Input::Odom(s) => s
+                .take()
+                .map_err(|e| anyhow::anyhow!("reading motion/odom: {e:?}"))?
+                .map(|(m, _)| (m.header.stamp, m.pose.pose)),
+            Input::Pose(s) => s
+                .take()
+                .map_err(|e| anyhow::anyhow!("reading motion/pose: {e:?}"))?
+                .map(|(m, _)| (m.header.stamp, m.pose)),
+        })
+    }
+}
+
+/// Runs the node until SIGINT/SIGTERM (or `duration` simulated seconds).
+pub fn run(
+    ros: &RosArgs,
+    fallback_params: Option<&str>,
+    opts: &NodeOptionsCli,
+) -> anyhow::Result<()> {
+    let cfg = load_parameters(ros, fallback_params)?;
+    let params = cfg.sim_params()?;
+    let names = Names::new(ros, DEFAULT_NAME)?;
+    let c = &cfg.config;
+    if !(c.motion_timeout_s.is_finite() && c.motion_timeout_s > 0.0) {
+        anyhow::bail!(
+            "{}: motion_timeout_s: must be a positive number of seconds, got {}",
+            cfg.source_name,
+            c.motion_timeout_s
+        );
+    }
+    let stop = super::shutdown_flag()?;
+    let context = super::context()?;
+    let mut node = context
+        .new_node(
+            NodeName::new(&names.namespace, &names.node).map_err(|e| {
+                anyhow::anyhow!("node name {}/{}: {e:?}", names.namespace, names.node)
+            })?,
+            NodeOptions::new().enable_rosout(true),
+        )
+        .map_err(|e| anyhow::anyhow!("cannot create the node: {e:?}"))?;
+
+    let input = match c.input.kind {
+        InputType::Odom => Input::Odom(super::subscription(
+            &mut node,
+            &names,
+            "motion/odom",
+            &qos_input(),
+        )?),
+        InputType::Pose => Input::Pose(super::subscription(
+            &mut node,
+            &names,
+            "motion/pose",
+            &qos_input(),
+        )?),
+    };
+    let out_qos = qos_outputs();
+    let pub_wrench: Publisher<WrenchStamped> =
+        super::publisher(&mut node, &names, "wrench", &out_qos)?;
+    let pub_probes: Publisher<ProbeArray> =
+        super::publisher(&mut node, &names, "probes", &out_qos)?;
+    let pub_press: Publisher<PressureArray> =
+        super::publisher(&mut node, &names, "pressures", &out_qos)?;
+    let pub_diag: Publisher<DiagnosticArray> =
+        super::publisher(&mut node, &names, "/diagnostics", &out_qos)?;
+    let pub_tf: Publisher<TFMessage> =
+        super::publisher(&mut node, &names, "/tf_static", &qos_latched())?;
+    let pub_clock: Option<Publisher<Clock>> = match c.realtime.mode {
+        RealtimeMode::Lockstep => Some(super::publisher(&mut node, &names, "/clock", &out_qos)?),
+        RealtimeMode::Realtime => None,
+    };
+
+    let frames = Frames::new(c.input.world_frame, c.input.body_frame, c.frames.tank_pose);
+    let mut motion = LiveMotion::new(Limits {
+        max_speed: c.input.max_speed,
+        max_rotation_rate: c.input.max_rotation_rate,
+    });
+    let mut sim = sph::build(params.clone())?;
+    let counts = sim.counts();
+    let full_name = format!(
+        "{}/{}",
+        if names.namespace == "/" {
+            ""
+        } else {
+            &names.namespace
+        },
+        names.node
+    );
+    let log = |level: ros2_client::ros2::LogLevel, msg: &str| {
+        eprintln!("[{full_name}] {msg}");
+        ros2_client::rosout!(node, level, "{}", msg);
+    };
+    log(
+        ros2_client::ros2::LogLevel::Info,
+        &format!(
+            "{}: {}D tank {} x {} x {} m, {} liquid + {} wall particles, {:?} mode; waiting for motion on {}",
+            cfg.source_name,
+            params.dimension,
+            params.tank.length,
+            params.tank.breadth,
+            params.tank.height,
+            counts.fluid,
+            counts.boundary,
+            c.realtime.mode,
+            names.resolve(match c.input.kind {
+                InputType::Odom => "motion/odom",
+                InputType::Pose => "motion/pose",
+            })?
+        ),
+    );
+
+    let start = Instant::now();
+    let wall = || start.elapsed().as_secs_f64();
+    let mut pacing = Pacing::new(0.25);
+    let mut counters = Counters::default();
+    let mut t0: Option<f64> = None;
+    let rate = c.output_rate_hz;
+    let mut next_output = 0u64;
+    let mut last_diag = f64::NEG_INFINITY;
+    let mut last_warn = f64::NEG_INFINITY;
+    let mut holding = false;
+    let mut tf_sent = false;
+    let dt_cap = params.solver.dt_max;
+    let mut error: Option<String> = None;
+
+    while !stop.load(Ordering::Relaxed) {
+        // 1. Drain the input.
+        let mut got = false;
+        while let Some((stamp, pose)) = input.take()? {
+            let w = wall();
+            let ts = match c.input.stamp {
+                StampSource::Header => stamp.as_secs_f64(),
+                StampSource::Receive => std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map(|d| d.as_secs_f64())
+                    .unwrap_or(0.0),
+            };
+            let base = *t0.get_or_insert(ts);
+            let (p, q) = pose_of(&pose);
+            let coords = frames.tank_coordinates(p, q);
+            match motion.push(ts - base, coords) {
+                Ok(()) => {
+                    counters.accepted += 1;
+                    pacing.input(w);
+                    got = true;
+                    if holding {
+                        holding = false;
+                        log(ros2_client::ros2::LogLevel::Info, "motion input is back");
+                    }
+                }
+                Err(e) => {
+                    counters.rejected += 1;
+                    counters.last_reject = e.to_string();
+                    if w - last_warn > 1.0 {
+                        last_warn = w;
+                        log(
+                            ros2_client::ros2::LogLevel::Warn,
+                            &format!(
+                                "rejected a motion sample: {e} ({} rejected so far)",
+                                counters.rejected
+                            ),
+                        );
+                    }
+                }
+            }
+        }
+        let Some(base) = t0 else {
+            std::thread::sleep(Duration::from_millis(2));
+            maybe_diagnostics(
+                &pub_diag,
+                &full_name,
+                wall(),
+                &mut last_diag,
+                c.diagnostics_rate_hz,
+                || {
+                    diagnostics(
+                        &full_name,
+                        None,
+                        &pacing,
+                        &counters,
+                        counts.fluid,
+                        sim.counts().lost,
+                        "waiting for motion input",
+                        wall(),
+                    )
+                },
+            );
+            continue;
+        };
+        if !tf_sent {
+            pub_tf
+                .publish(static_transforms(&cfg, &params, Time::from_secs_f64(base)))
+                .map_err(|e| anyhow::anyhow!("publishing /tf_static: {e:?}"))?;
+            tf_sent = true;
+        }
+        // 2. No input for too long (real-time mode): hold the last pose, at rest, and say so.
+        if c.realtime.mode == RealtimeMode::Realtime {
+            if let (Some(age), Some(last), Some(pose)) = (
+                pacing.input_age(wall()),
+                motion.newest(),
+                motion.last_pose(),
+            ) {
+                if age > c.motion_timeout_s {
+                    if !holding {
+                        holding = true;
+                        counters.timeouts += 1;
+                        log(
+                            ros2_client::ros2::LogLevel::Error,
+                            &format!("no motion input for {age:.2} s (motion_timeout_s = {}): holding the last pose", c.motion_timeout_s),
+                        );
+                    }
+                    // Samples of the held pose keep the simulation going in real time.
+                    let t_hold = last + 0.02;
+                    if motion.push(t_hold, pose).is_ok() {
+                        got = true;
+                    }
+                }
+            }
+        }
+        // 3. Step up to what the input allows.
+        let until = motion.safe_until(c.input.delay_samples);
+        let mut stepped = false;
+        if let Some(until) = until {
+            let mut limit = until;
+            if let Some(d) = opts.duration {
+                limit = limit.min(d + dt_cap);
+            }
+            while sim.time() + dt_cap < limit && !stop.load(Ordering::Relaxed) {
+                if let Err(e) = sim.step(&motion) {
+                    error = Some(e.to_string());
+                    break;
+                }
+                stepped = true;
+                let t = sim.time();
+                if t >= next_output as f64 / rate - 1e-9 {
+                    let o = match sim.observe(&motion) {
+                        Ok(o) => o,
+                        Err(e) => {
+                            error = Some(e.to_string());
+                            break;
+                        }
+                    };
+                    let stamp = Time::from_secs_f64(base + o.time);
+                    let m = output_messages(&params, &c.frames.tank, stamp, &o);
+                    publish(&pub_wrench, m.wrench, "wrench")?;
+                    publish(&pub_probes, m.probes, "probes")?;
+                    publish(&pub_press, m.pressures, "pressures")?;
+                    if let Some(pc) = &pub_clock {
+                        publish(pc, Clock { clock: stamp }, "/clock")?;
+                    }
+                    counters.published += 1;
+                    next_output = (t * rate + 1e-9).floor() as u64 + 1;
+                }
+                // Keep reading input and reporting while a long stretch is stepped.
+                if wall() - last_diag > 1.0 / c.diagnostics_rate_hz {
+                    break;
+                }
+            }
+            if error.is_some() {
+                break;
+            }
+            if pacing.record(wall(), sim.time(), until) && wall() - last_warn > 1.0 {
+                last_warn = wall();
+                log(
+                    ros2_client::ros2::LogLevel::Warn,
+                    &format!(
+                        "falling behind real time: simulation at {:.3} s, input at {until:.3} s (real-time factor {:.2})",
+                        sim.time(),
+                        pacing.realtime_factor()
+                    ),
+                );
+            }
+        }
+        let state = if holding {
+            "no motion input: holding the last pose"
+        } else if pacing.behind() {
+            "behind real time"
+        } else {
+            "running"
+        };
+        let w = wall();
+        maybe_diagnostics(
+            &pub_diag,
+            &full_name,
+            w,
+            &mut last_diag,
+            c.diagnostics_rate_hz,
+            || {
+                diagnostics(
+                    &full_name,
+                    Some(base + sim.time()),
+                    &pacing,
+                    &counters,
+                    counts.fluid,
+                    sim.counts().lost,
+                    state,
+                    w,
+                )
+            },
+        );
+        if let Some(d) = opts.duration {
+            if sim.time() >= d {
+                break;
+            }
+        }
+        if !got && !stepped {
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+    if let Some(e) = &error {
+        log(
+            ros2_client::ros2::LogLevel::Fatal,
+            &format!("solver stopped: {e}"),
+        );
+        let d = diagnostics(
+            &full_name,
+            t0.map(|b| b + sim.time()),
+            &pacing,
+            &counters,
+            counts.fluid,
+            sim.counts().lost,
+            e,
+            wall(),
+        );
+        let _ = pub_diag.publish(d);
+        anyhow::bail!("solver stopped at t = {:.4} s: {e}", sim.time());
+    }
+    log(
+        ros2_client::ros2::LogLevel::Info,
+        &format!(
+            "stopping at t = {:.3} s: {} samples accepted, {} rejected, {} outputs published",
+            sim.time(),
+            counters.accepted,
+            counters.rejected,
+            counters.published
+        ),
+    );
+    // Give reliable readers a moment to acknowledge the last messages before the participant goes away.
+    std::thread::sleep(Duration::from_millis(300));
+    Ok(())
+}
+
+fn publish<M: serde::Serialize + std::fmt::Debug>(
+    p: &Publisher<M>,
+    m: M,
+    what: &str,
+) -> anyhow::Result<()> {
+    match p.publish(m) {
+        Ok(()) => Ok(()),
+        // A slow reliable reader must not stop the simulation: the sample is dropped for it.
+        Err(ros2_client::WriteError::WouldBlock { .. }) => Ok(()),
+        Err(e) => Err(anyhow::anyhow!("publishing {what}: {e:?}")),
+    }
+}
+
+fn maybe_diagnostics(
+    p: &Publisher<DiagnosticArray>,
+    name: &str,
+    wall: f64,
+    last: &mut f64,
+    rate: f64,
+    make: impl FnOnce() -> DiagnosticArray,
+) {
+    if wall - *last >= 1.0 / rate {
+        *last = wall;
+        if let Err(e) = p.publish(make()) {
+            eprintln!("[{name}] publishing /diagnostics: {e:?}");
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn diagnostics(
+    name: &str,
+    stamp: Option<f64>,
+    pacing: &Pacing,
+    c: &Counters,
+    particles: usize,
+    lost: usize,
+    state: &str,
+    wall: f64,
+) -> DiagnosticArray {
+    let level = if stamp.is_none() || pacing.behind() {
+        DiagnosticStatus::WARN
+    } else if state.starts_with("running") {
+        DiagnosticStatus::OK
+    } else if state.starts_with("behind") {
+        DiagnosticStatus::WARN
+    } else {
+        DiagnosticStatus::ERROR
+    };
+    let kv = |k: &str, v: String| KeyValue {
+        key: k.to_string(),
+        value: v,
+    };
+    let age = pacing
+        .input_age(wall)
+        .map(|a| format!("{a:.3}"))
+        .unwrap_or_else(|| "none yet".into());
+    DiagnosticArray {
+        header: header(Time::from_secs_f64(stamp.unwrap_or(0.0)), ""),
+        status: vec![DiagnosticStatus {
+            level,
+            name: format!("{}: sloshing simulation", name.trim_start_matches('/')),
+            message: state.to_string(),
+            hardware_id: "slosh".into(),
+            values: vec![
+                kv(
+                    "realtime_factor",
+                    format!("{:.3}", pacing.realtime_factor()),
+                ),
+                kv("particles", particles.to_string()),
+                kv("particles_lost", lost.to_string()),
+                kv("input_age_s", age),
+                kv("samples_accepted", c.accepted.to_string()),
+                kv("samples_rejected", c.rejected.to_string()),
+                kv("last_rejection", c.last_reject.clone()),
+                kv("input_timeouts", c.timeouts.to_string()),
+                kv("overruns", pacing.overruns.to_string()),
+                kv("outputs_published", c.published.to_string()),
+            ],
+        }],
+    }
+}

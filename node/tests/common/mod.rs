@@ -1,0 +1,70 @@
+//! Shared by the tests that start DDS participants: they run inside a private network namespace that has only
+//! loopback (`unshare -n`), so no discovery traffic leaves the machine, on a laptop or in CI.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::Command;
+
+/// Marks a process that already runs inside the private namespace.
+const INSIDE: &str = "SLOSH_TEST_NETNS";
+
+/// Call first in a test. Outside the namespace it re-runs this one test (by its full name, e.g.
+/// `motion_to_node_to_subscriber`) in a new loopback-only network namespace, asserts that it passed and
+/// returns false; inside, it returns true and the test does its work.
+pub fn in_private_netns(test: &str) -> bool {
+    if std::env::var_os(INSIDE).is_some() {
+        return true;
+    }
+    let exe = std::env::current_exe().expect("test binary path");
+    let root = euid() == 0;
+    let setup = "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && exec \"$@\"";
+    let mut cmd = Command::new("unshare");
+    if !root {
+        // Unprivileged: a user namespace maps us to root inside, enough to configure loopback.
+        cmd.arg("-r");
+    }
+    cmd.args(["-n", "--", "sh", "-c", setup, "sh"])
+        .arg(&exe)
+        .args([test, "--exact", "--nocapture", "--test-threads", "1"])
+        .env(INSIDE, "1");
+    let status = cmd.status().unwrap_or_else(|e| {
+        panic!("cannot run `unshare` ({e}): install util-linux and iproute2 (apt-get install util-linux iproute2)")
+    });
+    assert!(
+        status.success(),
+        "{test} failed inside its loopback-only network namespace ({status}); its output is above"
+    );
+    false
+}
+
+fn euid() -> u32 {
+    // `id -u` keeps this free of libc bindings.
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .ok()
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or(1)
+}
+
+/// The Python interpreter of the test peers: `SLOSH_PYTHON`, else the workspace's `.venv`.
+pub fn python() -> PathBuf {
+    if let Some(p) = std::env::var_os("SLOSH_PYTHON") {
+        return PathBuf::from(p);
+    }
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../.venv/bin/python3");
+    assert!(
+        p.exists(),
+        "the Python test peers are missing: run `python3 -m venv .venv && .venv/bin/pip install -r tests/py/requirements.txt` in the workspace (or set SLOSH_PYTHON)"
+    );
+    p
+}
+
+/// A fresh temporary folder for one test.
+pub fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("slosh-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}

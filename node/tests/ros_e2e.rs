@@ -1,0 +1,269 @@
+//! End to end on a ROS 2 graph: `slosh motion` → `slosh node` → a subscriber, inside a loopback-only network
+//! namespace. The node's wrench and probe messages must match `slosh run` on the same motion.
+
+mod common;
+
+use ros2_client::qos::{History, WhenFull};
+use ros2_client::{
+    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
+};
+use slosh_msgs::diagnostic_msgs::DiagnosticArray;
+use slosh_msgs::geometry_msgs::WrenchStamped;
+use slosh_msgs::slosh_msgs::ProbeArray;
+use slosh_msgs::RosMessage;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const CASE: &str = "slosh:
+  ros__parameters:
+    dimension: 2
+    tank: {length: 0.8, breadth: 0.25, height: 0.6}
+    fill_height: 0.19
+    particle_spacing: 0.02
+    probes: {names: [left, mid], x: [-0.375, 0.0], y: [0.0, 0.0]}
+    pressure_sensors: {names: [wall], x: [-0.4], y: [0.0], z: [0.05]}
+    output_rate_hz: 20.0
+    motion:
+      source: regular
+      ramp_time: 0.5
+      regular: {amplitude: [0.015, 0, 0, 0, 0, 0], period: [1.5, 0, 0, 0, 0, 0], phase: [0, 0, 0, 0, 0, 0]}
+";
+
+/// Start of the motion's stamps (s since the epoch) so that output stamps map back to simulation time.
+const T0: f64 = 1000.0;
+const DURATION: f64 = 3.0;
+
+fn slosh() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_slosh"))
+}
+
+struct Kill(Child);
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn sub<M: RosMessage + 'static>(
+    node: &mut ros2_client::Node,
+    ns: &str,
+    name: &str,
+) -> ros2_client::Subscription<M> {
+    let qos = QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::Wait(Duration::from_millis(100)))
+        .history(History::KeepLast { depth: 100 });
+    let topic = node
+        .create_topic(
+            &Name::new(ns, name).unwrap(),
+            MessageTypeName::new(M::PACKAGE, M::NAME),
+            &qos,
+        )
+        .unwrap();
+    node.create_subscription::<M>(&topic, Some(qos)).unwrap()
+}
+
+/// (time, values) rows of a CSV written by `slosh run`.
+fn csv(path: &std::path::Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+#[test]
+fn motion_to_node_to_subscriber_matches_slosh_run() {
+    if !common::in_private_netns("motion_to_node_to_subscriber_matches_slosh_run") {
+        return;
+    }
+    let dir = common::tmp("ros-e2e");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, CASE).unwrap();
+    let domain = "17";
+    std::env::set_var("ROS_DOMAIN_ID", domain);
+
+    // The subscriber first, so it sees every output.
+    let ctx = Context::with_options(ContextOptions::new().domain_id(17)).unwrap();
+    let mut node = ctx
+        .new_node(
+            NodeName::new("/", "e2e_listener").unwrap(),
+            NodeOptions::new().enable_rosout(false),
+        )
+        .unwrap();
+    let wrench = sub::<WrenchStamped>(&mut node, "/ship1", "wrench");
+    let probes = sub::<ProbeArray>(&mut node, "/ship1", "probes");
+    let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
+
+    let node_proc = Kill(
+        slosh()
+            .args([
+                "node",
+                "--duration",
+                &DURATION.to_string(),
+                "--ros-args",
+                "--params-file",
+            ])
+            .arg(&case)
+            .args([
+                "-r",
+                "__ns:=/ship1",
+                "-r",
+                "__node:=tank2",
+                "-p",
+                "realtime.mode:=lockstep",
+            ])
+            .env("ROS_DOMAIN_ID", domain)
+            .stdout(Stdio::inherit())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .unwrap(),
+    );
+    let _motion = Kill(
+        slosh()
+            .arg("motion")
+            .arg(&case)
+            .args(["--rate", "50", "--duration", &(DURATION + 0.5).to_string()])
+            .args([
+                "--wait-for-subscribers",
+                "1",
+                "--start-stamp",
+                &T0.to_string(),
+            ])
+            .args(["--ros-args", "-r", "__ns:=/ship1"])
+            .env("ROS_DOMAIN_ID", domain)
+            .spawn()
+            .unwrap(),
+    );
+
+    let mut got_w: Vec<(f64, [f64; 6])> = Vec::new();
+    let mut got_p: Vec<(f64, Vec<f64>, Vec<String>)> = Vec::new();
+    let mut got_d: Vec<DiagnosticArray> = Vec::new();
+    let mut node_proc = node_proc;
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let mut exited = None;
+    while Instant::now() < deadline {
+        while let Ok(Some((m, _))) = wrench.take() {
+            let w = m.wrench;
+            got_w.push((
+                m.header.stamp.as_secs_f64() - T0,
+                [
+                    w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z,
+                ],
+            ));
+            assert_eq!(m.header.frame_id, "tank");
+        }
+        while let Ok(Some((m, _))) = probes.take() {
+            got_p.push((m.header.stamp.as_secs_f64() - T0, m.elevations, m.names));
+        }
+        while let Ok(Some((m, _))) = diags.take() {
+            got_d.push(m);
+        }
+        if exited.is_none() {
+            if let Some(st) = node_proc.0.try_wait().unwrap() {
+                exited = Some((st, Instant::now()));
+            }
+        }
+        if let Some((_, at)) = exited {
+            if at.elapsed() > Duration::from_millis(500) {
+                break;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let (status, _) = exited.expect("slosh node did not finish within 120 s");
+    assert!(status.success(), "slosh node failed: {status}");
+
+    // The same case by the offline runner, with the motion known exactly.
+    let out = dir.join("run");
+    let st = slosh()
+        .arg("run")
+        .arg(&case)
+        .arg("--out")
+        .arg(&out)
+        .args(["--duration", &DURATION.to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let run_w = csv(&out.join("wrench.csv"));
+    let run_p = csv(&out.join("probes.csv"));
+
+    let expected = (DURATION * 20.0) as usize;
+    assert!(
+        got_w.len() + 3 >= expected && got_p.len() + 3 >= expected,
+        "received {} wrench and {} probe messages, expected about {expected}",
+        got_w.len(),
+        got_p.len()
+    );
+    assert_eq!(got_p[0].2, ["left", "mid"]);
+    // Compare at equal times (both observe at the first step at or after k / 20 s).
+    let peak_fx = run_w.iter().map(|r| r[1].abs()).fold(0.0, f64::max);
+    assert!(
+        peak_fx > 1.0,
+        "the sway must load the tank (peak fx {peak_fx} N)"
+    );
+    // WCSPH wall forces carry sample-to-sample pressure noise, so the wrench is compared in the rms over the
+    // run; the node interpolates the sampled motion (50 Hz) where `slosh run` has it exactly.
+    let (mut d2, mut s2, mut compared) = (0.0, 0.0, 0usize);
+    let mut worst_probe = 0.0f64;
+    for (t, w) in &got_w {
+        let Some(r) = run_w.iter().find(|r| (r[0] - t).abs() < 2e-3) else {
+            continue;
+        };
+        d2 += (w[0] - r[1]).powi(2);
+        s2 += r[1].powi(2);
+        compared += 1;
+        if std::env::var_os("SLOSH_E2E_TRACE").is_some() {
+            println!("{t:.3} node fx {:8.3} run fx {:8.3}", w[0], r[1]);
+        }
+    }
+    for (t, e, _) in &got_p {
+        let Some(r) = run_p.iter().find(|r| (r[0] - t).abs() < 2e-3) else {
+            continue;
+        };
+        worst_probe = worst_probe
+            .max((e[0] - r[1]).abs())
+            .max((e[1] - r[2]).abs());
+    }
+    let rel = (d2 / s2).sqrt();
+    println!(
+        "compared {compared} wrench samples: rms(fx - fx_run) / rms(fx_run) = {rel:.3} (peak {peak_fx:.2} N); worst probe difference {worst_probe:.4} m"
+    );
+    assert!(
+        compared + 5 >= expected,
+        "only {compared} samples at matching times"
+    );
+    assert!(
+        rel < 0.1,
+        "fx differs from slosh run by {:.1} % rms",
+        100.0 * rel
+    );
+    assert!(
+        worst_probe < 0.01,
+        "probe elevations differ by {worst_probe} m"
+    );
+
+    // Diagnostics arrive and carry the documented keys.
+    let last = got_d.last().expect("no /diagnostics received");
+    let keys: Vec<&str> = last.status[0]
+        .values
+        .iter()
+        .map(|kv| kv.key.as_str())
+        .collect();
+    for k in [
+        "realtime_factor",
+        "particles",
+        "input_age_s",
+        "overruns",
+        "samples_rejected",
+    ] {
+        assert!(keys.contains(&k), "diagnostics lack {k}: {keys:?}");
+    }
+    assert!(
+        last.status[0].name.contains("ship1/tank2"),
+        "{}",
+        last.status[0].name
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
