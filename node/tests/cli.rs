@@ -206,3 +206,44 @@ fn a_solver_failure_keeps_the_outputs_written_so_far() {
     assert!(!rows.is_empty());
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn node_rejects_a_bad_parameter_at_startup_naming_it() {
+    let out = slosh()
+        .args([
+            "node",
+            "--ros-args",
+            "--params-file",
+            "../launch-configs/seed_tank_039.yaml",
+            "-p",
+            "solver.kernal:=wendland",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("solver.kernal") && err.contains("kernel"),
+        "{err}"
+    );
+    let out = slosh()
+        .args(["node", "--ros-args", "-r", "__ns:=ship1"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("__ns"));
+    let out = slosh()
+        .args([
+            "node",
+            "seed_tank_039",
+            "--ros-args",
+            "-p",
+            "motion_timeout_s:=-1",
+        ])
+        .env("ROS_DOMAIN_ID", "999")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("motion_timeout_s"), "{err}");
+}
