@@ -47,6 +47,36 @@ fn split_nanos(nanos: i64) -> (i32, u32) {
     }
 }
 
+/// Conversions of a `sec` + `nanosec` pair (Time and Duration share them).
+macro_rules! seconds_and_nanoseconds {
+    ($t:ident, $what:literal) => {
+        impl $t {
+            #[doc = concat!("The ", $what, " `t` seconds, rounded to the nearest nanosecond, saturating")]
+            /// outside the range of `i32` seconds (NaN gives zero).
+            pub fn from_secs_f64(t: f64) -> Self {
+                let (sec, nanosec) = split_secs_f64(t);
+                Self { sec, nanosec }
+            }
+
+            #[doc = concat!("The ", $what, " in seconds.")]
+            pub fn as_secs_f64(&self) -> f64 {
+                f64::from(self.sec) + f64::from(self.nanosec) * 1e-9
+            }
+
+            #[doc = concat!("The ", $what, " `nanos` nanoseconds, saturating outside the range of `i32` seconds.")]
+            pub fn from_nanos(nanos: i64) -> Self {
+                let (sec, nanosec) = split_nanos(nanos);
+                Self { sec, nanosec }
+            }
+
+            #[doc = concat!("The ", $what, " in nanoseconds.")]
+            pub fn as_nanos(&self) -> i64 {
+                i64::from(self.sec) * NANOS_PER_SEC + i64::from(self.nanosec)
+            }
+        }
+    };
+}
+
 /// `builtin_interfaces/msg/Time`: a point in ROS time, `sec + nanosec·1e-9` seconds.
 ///
 /// `nanosec` is in `[0, 1e9)` also for negative times: −0.25 s is `sec = −1, nanosec =
@@ -61,30 +91,7 @@ pub struct Time {
     pub nanosec: u32,
 }
 
-impl Time {
-    /// The time `t` seconds, rounded to the nearest nanosecond, saturating outside the range of
-    /// `i32` seconds (NaN gives zero).
-    pub fn from_secs_f64(t: f64) -> Self {
-        let (sec, nanosec) = split_secs_f64(t);
-        Self { sec, nanosec }
-    }
-
-    /// The time in seconds.
-    pub fn as_secs_f64(&self) -> f64 {
-        f64::from(self.sec) + f64::from(self.nanosec) * 1e-9
-    }
-
-    /// The time `nanos` nanoseconds, saturating outside the range of `i32` seconds.
-    pub fn from_nanos(nanos: i64) -> Self {
-        let (sec, nanosec) = split_nanos(nanos);
-        Self { sec, nanosec }
-    }
-
-    /// The time in nanoseconds.
-    pub fn as_nanos(&self) -> i64 {
-        i64::from(self.sec) * NANOS_PER_SEC + i64::from(self.nanosec)
-    }
-}
+seconds_and_nanoseconds!(Time, "time");
 
 /// `builtin_interfaces/msg/Duration`: a span of ROS time, `sec + nanosec·1e-9` seconds.
 ///
@@ -99,30 +106,7 @@ pub struct Duration {
     pub nanosec: u32,
 }
 
-impl Duration {
-    /// The duration `t` seconds, rounded to the nearest nanosecond, saturating outside the range
-    /// of `i32` seconds (NaN gives zero).
-    pub fn from_secs_f64(t: f64) -> Self {
-        let (sec, nanosec) = split_secs_f64(t);
-        Self { sec, nanosec }
-    }
-
-    /// The duration in seconds.
-    pub fn as_secs_f64(&self) -> f64 {
-        f64::from(self.sec) + f64::from(self.nanosec) * 1e-9
-    }
-
-    /// The duration `nanos` nanoseconds, saturating outside the range of `i32` seconds.
-    pub fn from_nanos(nanos: i64) -> Self {
-        let (sec, nanosec) = split_nanos(nanos);
-        Self { sec, nanosec }
-    }
-
-    /// The duration in nanoseconds.
-    pub fn as_nanos(&self) -> i64 {
-        i64::from(self.sec) * NANOS_PER_SEC + i64::from(self.nanosec)
-    }
-}
+seconds_and_nanoseconds!(Duration, "duration");
 
 ros_message!(Time, "builtin_interfaces", "Time", TIME_MSG, []);
 ros_message!(Duration, "builtin_interfaces", "Duration", DURATION_MSG, []);

@@ -14,15 +14,7 @@ use slosh_msgs::RosMessage;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-const CASE: &str = "slosh:
-  ros__parameters:
-    dimension: 2
-    tank: {length: 0.8, breadth: 0.25, height: 0.6}
-    fill_height: 0.19
-    particle_spacing: 0.02
-    probes: {names: [left, mid], x: [-0.375, 0.0], y: [0.0, 0.0]}
-    pressure_sensors: {names: [wall], x: [-0.4], y: [0.0], z: [0.05]}
-    output_rate_hz: 20.0
+const EXTRA: &str = "    pressure_sensors: {names: [wall], x: [-0.4], y: [0.0], z: [0.05]}
     motion:
       source: regular
       ramp_time: 0.5
@@ -80,7 +72,7 @@ fn motion_to_node_to_subscriber_matches_slosh_run() {
     }
     let dir = common::tmp("ros-e2e");
     let case = dir.join("case.yaml");
-    std::fs::write(&case, CASE).unwrap();
+    std::fs::write(&case, common::small_case(EXTRA)).unwrap();
     let domain = "17";
     std::env::set_var("ROS_DOMAIN_ID", domain);
 

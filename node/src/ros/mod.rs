@@ -36,6 +36,21 @@ pub fn ros_name(names: &args::Names, name: &str) -> anyhow::Result<Name> {
     Name::new(&ns, &base).map_err(|e| anyhow::anyhow!("topic `{name}`: {e:?}"))
 }
 
+/// The DDS topic of message type `M` on `name` (resolved and remapped by `names`).
+fn topic<M: RosMessage>(
+    node: &mut Node,
+    names: &args::Names,
+    name: &str,
+    qos: &QosProfile,
+) -> anyhow::Result<ros2_client::dds::rustdds::Topic> {
+    node.create_topic(
+        &ros_name(names, name)?,
+        MessageTypeName::new(M::PACKAGE, M::NAME),
+        qos,
+    )
+    .map_err(|e| anyhow::anyhow!("topic `{name}`: {e:?}"))
+}
+
 /// A publisher of `M` on `name` (resolved and remapped by `names`).
 pub fn publisher<M: RosMessage>(
     node: &mut Node,
@@ -43,13 +58,7 @@ pub fn publisher<M: RosMessage>(
     name: &str,
     qos: &QosProfile,
 ) -> anyhow::Result<ros2_client::Publisher<M>> {
-    let topic = node
-        .create_topic(
-            &ros_name(names, name)?,
-            MessageTypeName::new(M::PACKAGE, M::NAME),
-            qos,
-        )
-        .map_err(|e| anyhow::anyhow!("topic `{name}`: {e:?}"))?;
+    let topic = topic::<M>(node, names, name, qos)?;
     node.create_publisher::<M>(&topic, Some(qos.clone()))
         .map_err(|e| anyhow::anyhow!("publisher on `{name}`: {e:?}"))
 }
@@ -61,13 +70,7 @@ pub fn subscription<M: RosMessage + 'static>(
     name: &str,
     qos: &QosProfile,
 ) -> anyhow::Result<ros2_client::Subscription<M>> {
-    let topic = node
-        .create_topic(
-            &ros_name(names, name)?,
-            MessageTypeName::new(M::PACKAGE, M::NAME),
-            qos,
-        )
-        .map_err(|e| anyhow::anyhow!("topic `{name}`: {e:?}"))?;
+    let topic = topic::<M>(node, names, name, qos)?;
     node.create_subscription::<M>(&topic, Some(qos.clone()))
         .map_err(|e| anyhow::anyhow!("subscription to `{name}`: {e:?}"))
 }

@@ -68,3 +68,19 @@ pub fn tmp(name: &str) -> PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// A small 2D case (the seed tank's 0.19 m fill at dp = 20 mm) for the ROS 2 tests; `extra` is appended to its
+/// parameters (indented by four spaces).
+pub fn small_case(extra: &str) -> String {
+    format!(
+        "slosh:
+  ros__parameters:
+    dimension: 2
+    tank: {{length: 0.8, breadth: 0.25, height: 0.6}}
+    fill_height: 0.19
+    particle_spacing: 0.02
+    probes: {{names: [left, mid], x: [-0.375, 0.0], y: [0.0, 0.0]}}
+    output_rate_hz: 20.0
+{extra}"
+    )
+}

@@ -166,6 +166,14 @@ fn wide_lanes() -> bool {
     }
 }
 
+/// The liquid particle whose interactions are summed: position, velocity, density and p/ρ².
+struct Own<const D: usize> {
+    x: [f32; D],
+    v: [f32; D],
+    r: f32,
+    pr2: f32,
+}
+
 /// What one liquid particle's interactions add up to.
 struct Sums<const D: usize> {
     acc: [f32; D],
@@ -177,21 +185,17 @@ struct Sums<const D: usize> {
 
 /// All interactions of one liquid particle with the candidates of its cell (liquid `fc`, boundary `bc`).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn sums<const D: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     g: [f32; D],
-    xa: [f32; D],
-    va: [f32; D],
-    ra: f32,
-    pa_r2: f32,
+    a: &Own<D>,
     fc: &Candidates<D>,
     bc: &Candidates<D>,
 ) -> Sums<D> {
     let mut out = Acc::new();
-    interact::<D, K, true>(k, c, g, xa, va, ra, pa_r2, fc, &mut out);
-    interact::<D, K, false>(k, c, g, xa, va, ra, pa_r2, bc, &mut out);
+    interact::<D, K, true>(k, c, g, a.x, a.v, a.r, a.pr2, fc, &mut out);
+    interact::<D, K, false>(k, c, g, a.x, a.v, a.r, a.pr2, bc, &mut out);
     Sums {
         acc: std::array::from_fn(|d| sum(&out.acc[d])),
         drho: sum(&out.drho),
@@ -205,19 +209,15 @@ fn sums<const D: usize, K: Kernel>(
 /// particle so that the loop stays small enough for the vectoriser.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-#[allow(clippy::too_many_arguments)]
 fn sums_avx2<const D: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     g: [f32; D],
-    xa: [f32; D],
-    va: [f32; D],
-    ra: f32,
-    pa_r2: f32,
+    a: &Own<D>,
     fc: &Candidates<D>,
     bc: &Candidates<D>,
 ) -> Sums<D> {
-    sums(k, c, g, xa, va, ra, pa_r2, fc, bc)
+    sums(k, c, g, a, fc, bc)
 }
 
 /// Reused storage of [`fluid_rates`]: one pair of candidate buffers and one partial total per chunk.
@@ -269,21 +269,24 @@ fn chunk<const D: usize, K: Kernel>(
             let n = p.grid.ranges(filled, &bound.starts, &mut ranges);
             bc.fill(&ranges, n, &bound.x, &bound.v, &bound.r, &bound.pr2, c.rho0);
         }
-        let xa: [f32; D] = std::array::from_fn(|d| p.x[d][a]);
-        let va: [f32; D] = std::array::from_fn(|d| p.v[d][a]);
-        let (ra, pa_r2) = (p.r[a], p.pr2[a]);
+        let own = Own {
+            x: std::array::from_fn(|d| p.x[d][a]),
+            v: std::array::from_fn(|d| p.v[d][a]),
+            r: p.r[a],
+            pr2: p.pr2[a],
+        };
         let out = if p.wide {
             // SAFETY: `wide` is true only where the CPU reports AVX2 and FMA.
             #[cfg(target_arch = "x86_64")]
             unsafe {
-                sums_avx2(p.k, c, p.g, xa, va, ra, pa_r2, fc, bc)
+                sums_avx2(p.k, c, p.g, &own, fc, bc)
             }
             #[cfg(not(target_arch = "x86_64"))]
             unreachable!("wide lanes are x86_64 only")
         } else {
-            sums(p.k, c, p.g, xa, va, ra, pa_r2, fc, bc)
+            sums(p.k, c, p.g, &own, fc, bc)
         };
-        let fa: [f32; D] = from3(p.frame.acceleration(to3(xa), to3(va)));
+        let fa: [f32; D] = from3(p.frame.acceleration(to3(own.x), to3(own.v)));
         let mut a2 = 0.0f32;
         for d in 0..D {
             acc_a[d] = out.acc[d] + fa[d];
@@ -511,11 +514,17 @@ mod tests {
         for fluid in [true, false] {
             let (fc, bc) = if fluid { (&nb, &empty) } else { (&empty, &nb) };
             let (acc, drho, force) = naive(&k, &c, g, xa, va, r[a], pr2[a], &nb, fluid);
-            let mut fast = vec![sums(&k, &c, g, xa, va, r[a], pr2[a], fc, bc)];
+            let own = Own {
+                x: xa,
+                v: va,
+                r: r[a],
+                pr2: pr2[a],
+            };
+            let mut fast = vec![sums(&k, &c, g, &own, fc, bc)];
             #[cfg(target_arch = "x86_64")]
             if wide_lanes() {
                 // SAFETY: checked just above.
-                fast.push(unsafe { sums_avx2(&k, &c, g, xa, va, r[a], pr2[a], fc, bc) });
+                fast.push(unsafe { sums_avx2(&k, &c, g, &own, fc, bc) });
             }
             let scale = acc.iter().map(|a| a.abs()).fold(1e-3, f64::max);
             for s in &fast {
