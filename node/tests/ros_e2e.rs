@@ -112,6 +112,19 @@ fn motion_to_node_to_subscriber_matches_slosh_run() {
             .spawn()
             .unwrap(),
     );
+    // Start the motion once this subscriber has discovered the node's outputs, so none of them is missed.
+    let seen = Instant::now();
+    while ["/ship1/wrench", "/ship1/probes"]
+        .iter()
+        .any(|t| node.publisher_count(t) == 0)
+    {
+        assert!(
+            seen.elapsed() < Duration::from_secs(30),
+            "the node's publishers never appeared"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
     let _motion = Kill(
         slosh()
             .arg("motion")

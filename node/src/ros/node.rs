@@ -328,11 +328,15 @@ pub fn run(
     let mut tf_sent = false;
     let dt_cap = params.solver.dt_max;
     let mut error: Option<String> = None;
+    let mut pending: Vec<(Time, Pose)> = Vec::with_capacity(64);
 
     while !stop.load(Ordering::Relaxed) {
-        // 1. Drain the input.
+        // 1. Drain the input (and what was fetched while stepping).
         let mut got = false;
-        while let Some((stamp, pose)) = input.take()? {
+        while let Some(sample) = input.take()? {
+            pending.push(sample);
+        }
+        for (stamp, pose) in pending.drain(..) {
             let w = wall();
             let ts = match c.input.stamp {
                 StampSource::Header => stamp.as_secs_f64(),
@@ -437,6 +441,11 @@ pub fn run(
                     break;
                 }
                 stepped = true;
+                // Fetch input between steps so that the reader's short history (keep last 5) never
+                // overflows while a long stretch is stepped.
+                while let Some(sample) = input.take()? {
+                    pending.push(sample);
+                }
                 let t = sim.time();
                 if t >= next_output as f64 / rate - 1e-9 {
                     let o = match sim.observe(&motion) {
