@@ -1,4 +1,4 @@
-//! `std_srvs`: the [`Trigger`] and [`Empty`] services.
+//! `std_srvs`: the [`Trigger`], [`SetBool`] and [`Empty`] services.
 
 use serde::{Deserialize, Serialize};
 
@@ -32,6 +32,34 @@ impl RosService for Trigger {
     type Response = TriggerResponse;
 }
 
+/// `std_srvs/srv/SetBool`: set a boolean state (e.g. pause), answered by success and a message.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct SetBool;
+
+/// `std_srvs/srv/SetBool_Request`.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct SetBoolRequest {
+    /// E.g. for hardware enabling / disabling.
+    pub data: bool,
+}
+
+/// `std_srvs/srv/SetBool_Response`.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq, Eq, Hash, Default)]
+pub struct SetBoolResponse {
+    /// Whether the call succeeded.
+    pub success: bool,
+    /// Informational, e.g. an error message.
+    pub message: String,
+}
+
+impl RosService for SetBool {
+    const PACKAGE: &'static str = "std_srvs";
+    const NAME: &'static str = "SetBool";
+    const DEFINITION: &'static str = SET_BOOL_SRV;
+    type Request = SetBoolRequest;
+    type Response = SetBoolResponse;
+}
+
 /// `std_srvs/srv/Empty`: a request with no arguments and no answer but its arrival.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub struct Empty;
@@ -60,10 +88,15 @@ impl RosService for Empty {
 
 #[cfg(feature = "ros2-client")]
 mod ros2_client_impls {
-    use super::{EmptyRequest, EmptyResponse, TriggerRequest, TriggerResponse};
+    use super::{
+        EmptyRequest, EmptyResponse, SetBoolRequest, SetBoolResponse, TriggerRequest,
+        TriggerResponse,
+    };
 
     impl ros2_client::Message for TriggerRequest {}
     impl ros2_client::Message for TriggerResponse {}
+    impl ros2_client::Message for SetBoolRequest {}
+    impl ros2_client::Message for SetBoolResponse {}
     impl ros2_client::Message for EmptyRequest {}
     impl ros2_client::Message for EmptyResponse {}
 }
@@ -71,6 +104,12 @@ mod ros2_client_impls {
 // The interface files of ROS 2 Jazzy, verbatim.
 
 const TRIGGER_SRV: &str = r#"---
+bool success   # indicate successful run of triggered service
+string message # informational, e.g. for error messages
+"#;
+
+const SET_BOOL_SRV: &str = r#"bool data # e.g. for hardware enabling / disabling
+---
 bool success   # indicate successful run of triggered service
 string message # informational, e.g. for error messages
 "#;

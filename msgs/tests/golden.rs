@@ -31,7 +31,9 @@ use slosh_msgs::rosgraph_msgs::Clock;
 use slosh_msgs::sensor_msgs::{Imu, PointCloud2, PointField};
 use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
 use slosh_msgs::std_msgs::Header;
-use slosh_msgs::std_srvs::{EmptyRequest, EmptyResponse, TriggerRequest, TriggerResponse};
+use slosh_msgs::std_srvs::{
+    EmptyRequest, EmptyResponse, SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse,
+};
 use slosh_msgs::tf2_msgs::TFMessage;
 use slosh_msgs::{from_cdr, to_cdr, ALL_MESSAGES};
 
@@ -294,6 +296,17 @@ fn value_trigger_response() -> TriggerResponse {
     }
 }
 
+fn value_set_bool_request() -> SetBoolRequest {
+    SetBoolRequest { data: true }
+}
+
+fn value_set_bool_response() -> SetBoolResponse {
+    SetBoolResponse {
+        success: true,
+        message: "paused at t = 1.25 s".into(),
+    }
+}
+
 fn value_empty_request() -> EmptyRequest {
     EmptyRequest {
         structure_needs_at_least_one_member: 0,
@@ -459,6 +472,8 @@ golden_tests! {
     pressure_array: "slosh_msgs/msg/PressureArray" => value_pressure_array();
     trigger_request: "std_srvs/srv/Trigger_Request" => value_trigger_request();
     trigger_response: "std_srvs/srv/Trigger_Response" => value_trigger_response();
+    set_bool_request: "std_srvs/srv/SetBool_Request" => value_set_bool_request();
+    set_bool_response: "std_srvs/srv/SetBool_Response" => value_set_bool_response();
     empty_request: "std_srvs/srv/Empty_Request" => value_empty_request();
     empty_response: "std_srvs/srv/Empty_Response" => value_empty_response();
 }

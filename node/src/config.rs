@@ -187,6 +187,10 @@ pub struct RunConfig {
     /// s without motion input before the node holds the last pose and reports an error (`slosh node`).
     #[serde(default = "default_timeout")]
     pub motion_timeout_s: f64,
+    /// Request/reply mapping of the node's services: `enhanced` (rmw_fastrtps, ROS 2's default), `cyclone`
+    /// (rmw_cyclonedds) or `basic`.
+    #[serde(default)]
+    pub service_mapping: ServiceMappingCfg,
     /// Diagnostics messages per wall-clock second (`slosh node`).
     #[serde(default = "default_diag_rate")]
     pub diagnostics_rate_hz: f64,
@@ -197,6 +201,16 @@ fn default_timeout() -> f64 {
 }
 fn default_diag_rate() -> f64 {
     1.0
+}
+
+/// How requests and replies of services are matched on DDS (it differs between ROS 2 middlewares).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ServiceMappingCfg {
+    #[default]
+    Enhanced,
+    Cyclone,
+    Basic,
 }
 
 /// Which message drives the tank in `slosh node`.

@@ -272,3 +272,166 @@ fn motion_to_node_to_subscriber_matches_slosh_run() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Calls a service until it answers (the first requests may go out before discovery has matched).
+fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(
+    client: &ros2_client::Client<Req, Resp>,
+    req: Req,
+) -> Resp {
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_secs(30) {
+        let id = client.send_request(req.clone()).unwrap();
+        let sent = Instant::now();
+        while sent.elapsed() < Duration::from_millis(500) {
+            if let Ok(Some((rid, resp))) = client.receive_response() {
+                if rid == id {
+                    return resp;
+                }
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+    panic!("the service never answered");
+}
+
+#[test]
+fn pause_and_reset_services() {
+    use slosh_msgs::geometry_msgs::{Pose, PoseWithCovariance, Quaternion, TwistWithCovariance};
+    use slosh_msgs::nav_msgs::Odometry;
+    use slosh_msgs::std_msgs::Header;
+    use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
+    if !common::in_private_netns("pause_and_reset_services") {
+        return;
+    }
+    let dir = common::tmp("ros-services");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case("")).unwrap();
+    let ctx = Context::with_options(ContextOptions::new().domain_id(31)).unwrap();
+    let mut node = ctx
+        .new_node(
+            NodeName::new("/", "e2e_services").unwrap(),
+            NodeOptions::new().enable_rosout(false),
+        )
+        .unwrap();
+    let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    let odom_topic = node
+        .create_topic(
+            &Name::new("/motion", "odom").unwrap(),
+            MessageTypeName::new("nav_msgs", "Odometry"),
+            &qos,
+        )
+        .unwrap();
+    let odom = node
+        .create_publisher::<Odometry>(&odom_topic, Some(qos.clone()))
+        .unwrap();
+    let pause = node
+        .create_client::<SetBoolRequest, SetBoolResponse>(
+            ros2_client::ServiceMapping::Enhanced,
+            &Name::new("/slosh", "pause").unwrap(),
+            &ros2_client::ServiceTypeName::new("std_srvs", "SetBool"),
+            qos.clone(),
+            qos.clone(),
+        )
+        .unwrap();
+    let reset = node
+        .create_client::<TriggerRequest, TriggerResponse>(
+            ros2_client::ServiceMapping::Enhanced,
+            &Name::new("/slosh", "reset").unwrap(),
+            &ros2_client::ServiceTypeName::new("std_srvs", "Trigger"),
+            qos.clone(),
+            qos,
+        )
+        .unwrap();
+    let _node_proc = Kill(
+        slosh()
+            .args(["node", "--ros-args", "--params-file"])
+            .arg(&case)
+            .args(["-p", "realtime.mode:=lockstep"])
+            .env("ROS_DOMAIN_ID", "31")
+            .spawn()
+            .unwrap(),
+    );
+    while node.subscription_count("/motion/odom") == 0 || node.publisher_count("/wrench") == 0 {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    // Samples of a tank at rest, 50 Hz, stamps from 100 s on; `k` counts samples across the calls.
+    let k = std::cell::Cell::new(0u32);
+    let send = |n: u32| {
+        for _ in 0..n {
+            let k_now = k.get();
+            let t = 100.0 + k_now as f64 * 0.02;
+            let _ = odom.publish(Odometry {
+                header: Header {
+                    stamp: slosh_msgs::builtin_interfaces::Time::from_secs_f64(t),
+                    frame_id: "odom".into(),
+                },
+                child_frame_id: "base_link".into(),
+                pose: PoseWithCovariance {
+                    pose: Pose {
+                        orientation: Quaternion::identity(),
+                        ..Default::default()
+                    },
+                    covariance: [0.0; 36],
+                },
+                twist: TwistWithCovariance::default(),
+            });
+            k.set(k_now + 1);
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    };
+    let drain = |v: &mut Vec<(f64, f64)>| {
+        while let Ok(Some((m, _))) = wrench.take() {
+            v.push((m.header.stamp.as_secs_f64(), m.wrench.force.z));
+        }
+    };
+    let mut got = Vec::new();
+    send(30);
+    std::thread::sleep(Duration::from_millis(500));
+    drain(&mut got);
+    assert!(!got.is_empty(), "no wrench before the pause");
+    let r = call(&pause, SetBoolRequest { data: true });
+    assert!(
+        r.success && r.message.starts_with("paused at"),
+        "{}",
+        r.message
+    );
+    drain(&mut got);
+    let before = got.len();
+    send(30);
+    std::thread::sleep(Duration::from_millis(500));
+    drain(&mut got);
+    assert_eq!(got.len(), before, "outputs kept coming while paused");
+    let r = call(&pause, SetBoolRequest { data: false });
+    assert!(r.message.starts_with("resumed"), "{}", r.message);
+    let last_paused = got.last().unwrap().0;
+    send(30);
+    std::thread::sleep(Duration::from_millis(500));
+    drain(&mut got);
+    assert!(got.len() > before + 5, "no outputs after resuming");
+    // Resumed outputs are stamped on the input's time: after the samples sent while paused.
+    assert!(
+        got[before].0 > last_paused + 0.5,
+        "{} vs {last_paused}",
+        got[before].0
+    );
+    let r = call(&reset, TriggerRequest::default());
+    assert!(r.success, "{}", r.message);
+    drain(&mut got);
+    let n_reset = got.len();
+    let first_new = 100.0 + k.get() as f64 * 0.02;
+    send(30);
+    std::thread::sleep(Duration::from_millis(500));
+    drain(&mut got);
+    assert!(got.len() > n_reset + 5, "no outputs after the reset");
+    // After the reset the simulation starts again at t = 0, on the first new sample's stamp, at rest.
+    let (t, fz) = got[n_reset];
+    assert!(
+        (t - first_new).abs() < 0.025,
+        "first stamp after reset {t} vs {first_new}"
+    );
+    let weight = 1000.0 * 9.81 * 0.8 * 0.19 * 0.25;
+    assert!((fz + weight).abs() < 0.03 * weight, "fz after reset {fz}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

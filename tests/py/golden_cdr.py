@@ -207,6 +207,14 @@ def value_trigger_request():
     return TriggerRequest(structure_needs_at_least_one_member=0)
 
 
+def value_set_bool_request():
+    return SetBoolRequest(data=True)
+
+
+def value_set_bool_response():
+    return SetBoolResponse(success=True, message="paused at t = 1.25 s")
+
+
 def value_trigger_response():
     return TriggerResponse(success=True, message="reset done")
 
@@ -251,6 +259,8 @@ VALUES = {
     "slosh_msgs/msg/PressureArray": value_pressure_array,
     "std_srvs/srv/Trigger_Request": value_trigger_request,
     "std_srvs/srv/Trigger_Response": value_trigger_response,
+    "std_srvs/srv/SetBool_Request": value_set_bool_request,
+    "std_srvs/srv/SetBool_Response": value_set_bool_response,
     "std_srvs/srv/Empty_Request": value_empty_request,
     "std_srvs/srv/Empty_Response": value_empty_response,
 }

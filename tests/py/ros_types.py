@@ -223,6 +223,17 @@ class TriggerResponse(IdlStruct, typename="std_srvs::srv::dds_::Trigger_Response
 
 
 @dataclass
+class SetBoolRequest(IdlStruct, typename="std_srvs::srv::dds_::SetBool_Request_"):
+    data: bool
+
+
+@dataclass
+class SetBoolResponse(IdlStruct, typename="std_srvs::srv::dds_::SetBool_Response_"):
+    success: bool
+    message: str
+
+
+@dataclass
 class EmptyRequest(IdlStruct, typename="std_srvs::srv::dds_::Empty_Request_"):
     structure_needs_at_least_one_member: t.uint8
 

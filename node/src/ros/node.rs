@@ -9,7 +9,7 @@ use super::pacing::Pacing;
 use crate::config::{InputType, Loaded, RealtimeMode, StampSource};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use ros2_client::qos::{Durability, History, WhenFull};
-use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile};
+use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile, ServiceMapping, ServiceTypeName};
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
 use slosh_msgs::geometry_msgs::{
@@ -20,6 +20,7 @@ use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
 use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
 use slosh_msgs::std_msgs::Header;
+use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
 use slosh_msgs::tf2_msgs::TFMessage;
 use sph::params::SimParams;
 use std::sync::atomic::Ordering;
@@ -276,6 +277,31 @@ pub fn run(
         RealtimeMode::Realtime => None,
     };
 
+    let srv_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    let mapping = match c.service_mapping {
+        crate::config::ServiceMappingCfg::Enhanced => ServiceMapping::Enhanced,
+        crate::config::ServiceMappingCfg::Cyclone => ServiceMapping::Cyclone,
+        crate::config::ServiceMappingCfg::Basic => ServiceMapping::Basic,
+    };
+    let srv_reset = node
+        .create_server::<TriggerRequest, TriggerResponse>(
+            mapping,
+            &super::ros_name(&names, "~/reset")?,
+            &ServiceTypeName::new("std_srvs", "Trigger"),
+            srv_qos.clone(),
+            srv_qos.clone(),
+        )
+        .map_err(|e| anyhow::anyhow!("service ~/reset: {e:?}"))?;
+    let srv_pause = node
+        .create_server::<SetBoolRequest, SetBoolResponse>(
+            mapping,
+            &super::ros_name(&names, "~/pause")?,
+            &ServiceTypeName::new("std_srvs", "SetBool"),
+            srv_qos.clone(),
+            srv_qos,
+        )
+        .map_err(|e| anyhow::anyhow!("service ~/pause: {e:?}"))?;
+
     let frames = Frames::new(c.input.world_frame, c.input.body_frame, c.frames.tank_pose);
     let mut motion = LiveMotion::new(Limits {
         max_speed: c.input.max_speed,
@@ -329,8 +355,59 @@ pub fn run(
     let dt_cap = params.solver.dt_max;
     let mut error: Option<String> = None;
     let mut pending: Vec<(Time, Pose)> = Vec::with_capacity(64);
+    let mut paused = false;
+    // After a reset or a resume the next sample is placed at the current simulation time.
+    let mut rebase = false;
+    let limits = Limits {
+        max_speed: c.input.max_speed,
+        max_rotation_rate: c.input.max_rotation_rate,
+    };
 
     while !stop.load(Ordering::Relaxed) {
+        // 0. Services: ~/reset starts the liquid again at rest, ~/pause freezes the simulation.
+        while let Ok(Some((id, _))) = srv_reset.receive_request() {
+            sim = sph::build(params.clone())?;
+            motion = LiveMotion::new(limits);
+            next_output = 0;
+            rebase = t0.is_some();
+            let message = "liquid reset to rest; the next motion sample is t = 0".to_string();
+            log(
+                ros2_client::ros2::LogLevel::Info,
+                &format!("~/reset: {message}"),
+            );
+            let _ = srv_reset.send_response(
+                id,
+                TriggerResponse {
+                    success: true,
+                    message,
+                },
+            );
+        }
+        while let Ok(Some((id, req))) = srv_pause.receive_request() {
+            let message = if req.data == paused {
+                format!("already {}", if paused { "paused" } else { "running" })
+            } else if req.data {
+                paused = true;
+                format!("paused at t = {:.4} s", sim.time())
+            } else {
+                paused = false;
+                // Resume from the current input without catching up on the paused stretch.
+                motion = LiveMotion::new(limits);
+                rebase = t0.is_some();
+                format!("resumed at t = {:.4} s", sim.time())
+            };
+            log(
+                ros2_client::ros2::LogLevel::Info,
+                &format!("~/pause: {message}"),
+            );
+            let _ = srv_pause.send_response(
+                id,
+                SetBoolResponse {
+                    success: true,
+                    message,
+                },
+            );
+        }
         // 1. Drain the input (and what was fetched while stepping).
         let mut got = false;
         while let Some(sample) = input.take()? {
@@ -345,6 +422,10 @@ pub fn run(
                     .map(|d| d.as_secs_f64())
                     .unwrap_or(0.0),
             };
+            if rebase {
+                rebase = false;
+                t0 = Some(ts - sim.time());
+            }
             let base = *t0.get_or_insert(ts);
             let (p, q) = pose_of(&pose);
             let coords = frames.tank_coordinates(p, q);
@@ -428,7 +509,11 @@ pub fn run(
             }
         }
         // 3. Step up to what the input allows.
-        let until = motion.safe_until(c.input.delay_samples);
+        let until = if paused {
+            None
+        } else {
+            motion.safe_until(c.input.delay_samples)
+        };
         let mut stepped = false;
         if let Some(until) = until {
             let mut limit = until;
@@ -486,7 +571,9 @@ pub fn run(
                 );
             }
         }
-        let state = if holding {
+        let state = if paused {
+            "paused (~/pause)"
+        } else if holding {
             "no motion input: holding the last pose"
         } else if pacing.behind() {
             "behind real time"
