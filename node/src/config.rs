@@ -293,6 +293,9 @@ pub enum RealtimeMode {
     Realtime,
     /// As fast as the input allows, publishing `/clock` (CI, replay).
     Lockstep,
+    /// Never ahead of the ROS time on `/clock` (rosgraph_msgs/Clock, e.g. `ros2 bag play --clock`), as
+    /// nodes with `use_sim_time` do.
+    FollowClock,
 }
 
 #[derive(Debug, Clone, Copy, Default, Deserialize)]

@@ -7,9 +7,14 @@ use ros2_client::qos::{History, WhenFull};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
 };
+use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::DiagnosticArray;
 use slosh_msgs::geometry_msgs::WrenchStamped;
+use slosh_msgs::geometry_msgs::{Pose, PoseWithCovariance, Quaternion, TwistWithCovariance};
+use slosh_msgs::nav_msgs::Odometry;
+use slosh_msgs::rosgraph_msgs::Clock;
 use slosh_msgs::slosh_msgs::ProbeArray;
+use slosh_msgs::std_msgs::Header;
 use slosh_msgs::RosMessage;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -273,6 +278,42 @@ fn motion_to_node_to_subscriber_matches_slosh_run() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+fn publisher<M: RosMessage>(
+    node: &mut ros2_client::Node,
+    ns: &str,
+    name: &str,
+    qos: &QosProfile,
+) -> ros2_client::Publisher<M> {
+    let topic = node
+        .create_topic(
+            &Name::new(ns, name).unwrap(),
+            MessageTypeName::new(M::PACKAGE, M::NAME),
+            qos,
+        )
+        .unwrap();
+    node.create_publisher::<M>(&topic, Some(qos.clone()))
+        .unwrap()
+}
+
+/// Odometry of a vessel at rest at the origin, stamped `t` s.
+fn rest_odometry(t: f64) -> Odometry {
+    Odometry {
+        header: Header {
+            stamp: Time::from_secs_f64(t),
+            frame_id: "odom".into(),
+        },
+        child_frame_id: "base_link".into(),
+        pose: PoseWithCovariance {
+            pose: Pose {
+                orientation: Quaternion::identity(),
+                ..Default::default()
+            },
+            covariance: [0.0; 36],
+        },
+        twist: TwistWithCovariance::default(),
+    }
+}
+
 /// Calls a service until it answers (the first requests may go out before discovery has matched).
 fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(
     client: &ros2_client::Client<Req, Resp>,
@@ -296,9 +337,6 @@ fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message 
 
 #[test]
 fn pause_and_reset_services() {
-    use slosh_msgs::geometry_msgs::{Pose, PoseWithCovariance, Quaternion, TwistWithCovariance};
-    use slosh_msgs::nav_msgs::Odometry;
-    use slosh_msgs::std_msgs::Header;
     use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
     if !common::in_private_netns("pause_and_reset_services") {
         return;
@@ -315,16 +353,7 @@ fn pause_and_reset_services() {
         .unwrap();
     let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
-    let odom_topic = node
-        .create_topic(
-            &Name::new("/motion", "odom").unwrap(),
-            MessageTypeName::new("nav_msgs", "Odometry"),
-            &qos,
-        )
-        .unwrap();
-    let odom = node
-        .create_publisher::<Odometry>(&odom_topic, Some(qos.clone()))
-        .unwrap();
+    let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
     let pause = node
         .create_client::<SetBoolRequest, SetBoolResponse>(
             ros2_client::ServiceMapping::Enhanced,
@@ -362,21 +391,7 @@ fn pause_and_reset_services() {
         for _ in 0..n {
             let k_now = k.get();
             let t = 100.0 + k_now as f64 * 0.02;
-            let _ = odom.publish(Odometry {
-                header: Header {
-                    stamp: slosh_msgs::builtin_interfaces::Time::from_secs_f64(t),
-                    frame_id: "odom".into(),
-                },
-                child_frame_id: "base_link".into(),
-                pose: PoseWithCovariance {
-                    pose: Pose {
-                        orientation: Quaternion::identity(),
-                        ..Default::default()
-                    },
-                    covariance: [0.0; 36],
-                },
-                twist: TwistWithCovariance::default(),
-            });
+            let _ = odom.publish(rest_odometry(t));
             k.set(k_now + 1);
             std::thread::sleep(Duration::from_millis(20));
         }
@@ -433,5 +448,80 @@ fn pause_and_reset_services() {
     );
     let weight = 1000.0 * 9.81 * 0.8 * 0.19 * 0.25;
     assert!((fz + weight).abs() < 0.03 * weight, "fz after reset {fz}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn follow_clock_never_runs_ahead_of_ros_time() {
+    if !common::in_private_netns("follow_clock_never_runs_ahead_of_ros_time") {
+        return;
+    }
+    let dir = common::tmp("ros-clock");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case("")).unwrap();
+    let ctx = Context::with_options(ContextOptions::new().domain_id(37)).unwrap();
+    let mut node = ctx
+        .new_node(
+            NodeName::new("/", "e2e_clock").unwrap(),
+            NodeOptions::new().enable_rosout(false),
+        )
+        .unwrap();
+    let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
+    // As `ros2 bag play --clock` publishes it: rosgraph_msgs/Clock, best effort.
+    let clock = publisher::<Clock>(
+        &mut node,
+        "/",
+        "clock",
+        &QosProfile::subscription_default().history(History::KeepLast { depth: 1 }),
+    );
+    let _node_proc = Kill(
+        slosh()
+            .args(["node", "--ros-args", "--params-file"])
+            .arg(&case)
+            .args(["-p", "realtime.mode:=follow_clock"])
+            .env("ROS_DOMAIN_ID", "37")
+            .spawn()
+            .unwrap(),
+    );
+    while node.subscription_count("/motion/odom") == 0 || node.publisher_count("/wrench") == 0 {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let newest = |v: &mut f64| {
+        while let Ok(Some((m, _))) = wrench.take() {
+            *v = v.max(m.header.stamp.as_secs_f64());
+        }
+    };
+    // One second of motion is known, but ROS time stands at 200.3 s: outputs stop there.
+    for k in 0..50 {
+        let _ = odom.publish(rest_odometry(200.0 + k as f64 * 0.02));
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let mut last = f64::NEG_INFINITY;
+    for _ in 0..20 {
+        let _ = clock.publish(Clock {
+            clock: Time::from_secs_f64(200.3),
+        });
+        std::thread::sleep(Duration::from_millis(50));
+        newest(&mut last);
+    }
+    assert!(
+        last > 200.2 && last <= 200.3 + 1e-6,
+        "newest output stamp {last}, ROS time 200.3"
+    );
+    // ROS time moves on: so does the simulation.
+    for _ in 0..20 {
+        let _ = clock.publish(Clock {
+            clock: Time::from_secs_f64(200.7),
+        });
+        std::thread::sleep(Duration::from_millis(50));
+        newest(&mut last);
+    }
+    assert!(
+        last > 200.6 && last <= 200.7 + 1e-6,
+        "newest output stamp {last}, ROS time 200.7"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

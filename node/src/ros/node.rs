@@ -274,8 +274,20 @@ pub fn run(
         super::publisher(&mut node, &names, "/tf_static", &qos_latched())?;
     let pub_clock: Option<Publisher<Clock>> = match c.realtime.mode {
         RealtimeMode::Lockstep => Some(super::publisher(&mut node, &names, "/clock", &out_qos)?),
-        RealtimeMode::Realtime => None,
+        _ => None,
     };
+    // follow_clock: ROS time from /clock (best effort keep last 1, as rclcpp's ClockQoS; reliable
+    // publishers connect too).
+    let sub_clock: Option<ros2_client::Subscription<Clock>> = match c.realtime.mode {
+        RealtimeMode::FollowClock => Some(super::subscription(
+            &mut node,
+            &names,
+            "/clock",
+            &QosProfile::subscription_default().history(History::KeepLast { depth: 1 }),
+        )?),
+        _ => None,
+    };
+    let mut ros_time: Option<f64> = None;
 
     let srv_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let mapping = match c.service_mapping {
@@ -509,10 +521,25 @@ pub fn run(
             }
         }
         // 3. Step up to what the input allows.
+        if let Some(sc) = &sub_clock {
+            while let Ok(Some((m, _))) = sc.take() {
+                ros_time = Some(m.clock.as_secs_f64());
+            }
+        }
         let until = if paused {
             None
         } else {
-            motion.safe_until(c.input.delay_samples)
+            match (
+                motion.safe_until(c.input.delay_samples),
+                &sub_clock,
+                ros_time,
+            ) {
+                (u, None, _) => u,
+                // Following /clock: not past the ROS time (mapped to simulation time).
+                (Some(u), Some(_), Some(now)) => Some(u.min(now - base)),
+                (_, Some(_), None) => None,
+                (None, _, _) => None,
+            }
         };
         let mut stepped = false;
         if let Some(until) = until {
