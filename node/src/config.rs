@@ -191,6 +191,9 @@ pub struct RunConfig {
     /// (rmw_cyclonedds) or `basic`.
     #[serde(default)]
     pub service_mapping: ServiceMappingCfg,
+    /// The `particles` PointCloud2 output of `slosh node` (off by default).
+    #[serde(default)]
+    pub particles: ParticlesCfg,
     /// Diagnostics messages per wall-clock second (`slosh node`).
     #[serde(default = "default_diag_rate")]
     pub diagnostics_rate_hz: f64,
@@ -201,6 +204,25 @@ fn default_timeout() -> f64 {
 }
 fn default_diag_rate() -> f64 {
     1.0
+}
+
+/// The node's particle cloud output.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ParticlesCfg {
+    /// Clouds per simulated second (0: off).
+    pub rate_hz: f64,
+    /// Publish every n-th liquid particle.
+    pub decimation: usize,
+}
+
+impl Default for ParticlesCfg {
+    fn default() -> Self {
+        Self {
+            rate_hz: 0.0,
+            decimation: 1,
+        }
+    }
 }
 
 /// How requests and replies of services are matched on DDS (it differs between ROS 2 middlewares).

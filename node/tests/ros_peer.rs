@@ -25,6 +25,7 @@ fn cyclonedds_peer_drives_the_node_and_reads_its_outputs() {
         .args(["node", "--duration", "2.0", "--ros-args", "--params-file"])
         .arg(&case)
         .args(["-r", "__ns:=/peer", "-p", "realtime.mode:=lockstep"])
+        .args(["-p", "particles:={rate_hz: 5.0, decimation: 4}"])
         .env("ROS_DOMAIN_ID", domain)
         .spawn()
         .unwrap();
@@ -107,6 +108,18 @@ fn cyclonedds_peer_drives_the_node_and_reads_its_outputs() {
         (pb - 1000.0 * 9.81 * 0.19).abs() < 0.1 * 1000.0 * 9.81 * 0.19,
         "bottom pressure {pb}"
     );
+    // The particle cloud: 5 Hz, every 4th of the 400 particles, x y z speed as float32, inside the tank.
+    let n = v["counts"]["particles"].as_u64().unwrap();
+    assert!((10..=12).contains(&n), "{n} clouds, expected 11");
+    let c = &v["particles_last"];
+    assert_eq!(c["width"], 100);
+    assert_eq!(c["frame_id"], "tank");
+    assert_eq!(c["fields"], serde_json::json!(["x", "y", "z", "speed"]));
+    for pt in c["points"].as_array().unwrap() {
+        let (x, z) = (pt["x"].as_f64().unwrap(), pt["z"].as_f64().unwrap());
+        assert!(x.abs() < 0.4 && (0.0..0.25).contains(&z), "point {pt}");
+        assert!(pt["speed"].as_f64().unwrap() < 0.2, "a tank at rest: {pt}");
+    }
     let d = &v["diagnostics_last"];
     assert!(
         d["name"].as_str().unwrap().contains("peer/slosh"),

@@ -14,6 +14,7 @@ counts and the last values received.
 import argparse
 import json
 import math
+import struct
 import sys
 import time
 
@@ -24,7 +25,7 @@ from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
-from ros_types import (DiagnosticArray, Header, Odometry, Point, Pose, PoseWithCovariance,
+from ros_types import (DiagnosticArray, Header, Odometry, Point, PointCloud2, Pose, PoseWithCovariance,
                        PressureArray, ProbeArray, Quaternion, Time, Twist, TwistWithCovariance,
                        Vector3, WrenchStamped)
 
@@ -58,9 +59,10 @@ def main():
         "probes": DataReader(dp, Topic(dp, f"rt{ns}/probes", ProbeArray), qos=reliable),
         "pressures": DataReader(dp, Topic(dp, f"rt{ns}/pressures", PressureArray), qos=reliable),
         "diagnostics": DataReader(dp, Topic(dp, "rt/diagnostics", DiagnosticArray), qos=reliable),
+        "particles": DataReader(dp, Topic(dp, f"rt{ns}/particles", PointCloud2), qos=reliable),
     }
     types = {"wrench": WrenchStamped, "probes": ProbeArray, "pressures": PressureArray,
-             "diagnostics": DiagnosticArray}
+             "diagnostics": DiagnosticArray, "particles": PointCloud2}
     got = {k: [] for k in readers}
 
     def drain():
@@ -107,6 +109,15 @@ def main():
         return h.stamp.sec + h.stamp.nanosec * 1e-9 - a.t0
 
     w, p, pr, d = got["wrench"], got["probes"], got["pressures"], got["diagnostics"]
+    c = got["particles"]
+
+    def points(cloud):
+        """Decodes the cloud by its declared fields (float32 only)."""
+        offs = {f.name: f.offset for f in cloud.fields}
+        raw = bytes(cloud.data)
+        fmt = ">f" if cloud.is_bigendian else "<f"
+        return [{k: struct.unpack_from(fmt, raw, i * cloud.point_step + o)[0] for k, o in offs.items()}
+                for i in range(cloud.width * cloud.height)]
     out = {
         "counts": {k: len(v) for k, v in got.items()},
         "wrench_last": None if not w else {
@@ -119,6 +130,9 @@ def main():
             "positions": [[q.x, q.y, q.z] for q in p[-1].positions]},
         "pressures_last": None if not pr else {
             "names": list(pr[-1].names), "pressures": list(pr[-1].pressures)},
+        "particles_last": None if not c else {
+            "width": c[-1].width, "frame_id": c[-1].header.frame_id,
+            "fields": [f.name for f in c[-1].fields], "points": points(c[-1])},
         "diagnostics_last": None if not d else {
             "name": d[-1].status[0].name, "level": level(d[-1].status[0].level),
             "message": d[-1].status[0].message,

@@ -2,6 +2,7 @@
 //! what they share — argument parsing and name resolution, frame conventions, live motion, pacing.
 
 pub mod args;
+pub mod cloud;
 pub mod frames;
 pub mod live_motion;
 pub mod motion_pub;

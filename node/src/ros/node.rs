@@ -19,6 +19,7 @@ use slosh_msgs::geometry_msgs::{
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
 use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
+use slosh_msgs::sensor_msgs::PointCloud2;
 use slosh_msgs::std_msgs::Header;
 use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
 use slosh_msgs::tf2_msgs::TFMessage;
@@ -276,6 +277,15 @@ pub fn run(
         RealtimeMode::Lockstep => Some(super::publisher(&mut node, &names, "/clock", &out_qos)?),
         _ => None,
     };
+    let pub_cloud: Option<Publisher<PointCloud2>> = if c.particles.rate_hz > 0.0 {
+        let qos = QosProfile::publisher_default()
+            .reliability_reliable(WhenFull::Wait(Duration::from_millis(20)))
+            .history(History::KeepLast { depth: 1 });
+        Some(super::publisher(&mut node, &names, "particles", &qos)?)
+    } else {
+        None
+    };
+    let mut next_cloud = 0u64;
     // follow_clock: ROS time from /clock (best effort keep last 1, as rclcpp's ClockQoS; reliable
     // publishers connect too).
     let sub_clock: Option<ros2_client::Subscription<Clock>> = match c.realtime.mode {
@@ -381,6 +391,7 @@ pub fn run(
             sim = sph::build(params.clone())?;
             motion = LiveMotion::new(limits);
             next_output = 0;
+            next_cloud = 0;
             rebase = t0.is_some();
             let message = "liquid reset to rest; the next motion sample is t = 0".to_string();
             log(
@@ -576,6 +587,19 @@ pub fn run(
                         publish(pc, Clock { clock: stamp }, "/clock")?;
                     }
                     counters.published += 1;
+                    if let Some(pc) = &pub_cloud {
+                        if t >= next_cloud as f64 / c.particles.rate_hz - 1e-9 {
+                            let cloud = super::cloud::particle_cloud(
+                                stamp,
+                                &c.frames.tank,
+                                &sim.fluid_positions(),
+                                &sim.fluid_velocities(),
+                                c.particles.decimation,
+                            );
+                            publish(pc, cloud, "particles")?;
+                            next_cloud = (t * c.particles.rate_hz + 1e-9).floor() as u64 + 1;
+                        }
+                    }
                     next_output = (t * rate + 1e-9).floor() as u64 + 1;
                 }
                 // Keep reading input and reporting while a long stretch is stepped.
