@@ -525,3 +525,58 @@ fn follow_clock_never_runs_ahead_of_ros_time() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn ros_domain_id_takes_effect() {
+    if !common::in_private_netns("ros_domain_id_takes_effect") {
+        return;
+    }
+    let dir = common::tmp("ros-domain");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case("    diagnostics_rate_hz: 5.0\n")).unwrap();
+    let listen = |domain: u16| {
+        let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
+        let mut node = ctx
+            .new_node(
+                NodeName::new("/", &format!("e2e_domain_{domain}")).unwrap(),
+                NodeOptions::new().enable_rosout(false),
+            )
+            .unwrap();
+        let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
+        (ctx, node, diags)
+    };
+    let (_c1, _n1, right) = listen(41);
+    let (_c2, _n2, wrong) = listen(42);
+    let _node_proc = Kill(
+        slosh()
+            .args(["node", "--ros-args", "--params-file"])
+            .arg(&case)
+            .env("ROS_DOMAIN_ID", "41")
+            .spawn()
+            .unwrap(),
+    );
+    let (mut n_right, mut n_wrong) = (0, 0);
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_secs(4) {
+        while let Ok(Some(_)) = right.take() {
+            n_right += 1;
+        }
+        while let Ok(Some(_)) = wrong.take() {
+            n_wrong += 1;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(
+        n_right >= 3,
+        "{n_right} diagnostics on the node's domain 41"
+    );
+    assert_eq!(n_wrong, 0, "diagnostics leaked to domain 42");
+    let out = slosh()
+        .args(["node", "seed_tank_039"])
+        .env("ROS_DOMAIN_ID", "ship")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("ROS_DOMAIN_ID=ship"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -62,8 +62,17 @@ mod tests {
             let o = i * c.point_step as usize + field(name);
             f32::from_le_bytes(c.data[o..o + 4].try_into().unwrap())
         };
-        assert_eq!((read(0, "x"), read(0, "z"), read(0, "speed")), (0.1, 0.2, 5.0));
-        assert_eq!((read(1, "x"), read(1, "z"), read(1, "speed")), (0.5, 0.6, 1.0));
-        assert!(c.fields.iter().all(|f| f.datatype == PointField::FLOAT32 && f.count == 1));
+        assert_eq!(
+            (read(0, "x"), read(0, "z"), read(0, "speed")),
+            (0.1, 0.2, 5.0)
+        );
+        assert_eq!(
+            (read(1, "x"), read(1, "z"), read(1, "speed")),
+            (0.5, 0.6, 1.0)
+        );
+        assert!(c
+            .fields
+            .iter()
+            .all(|f| f.datatype == PointField::FLOAT32 && f.count == 1));
     }
 }

@@ -18,8 +18,8 @@ use slosh_msgs::geometry_msgs::{
 };
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
-use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
 use slosh_msgs::sensor_msgs::PointCloud2;
+use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
 use slosh_msgs::std_msgs::Header;
 use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
 use slosh_msgs::tf2_msgs::TFMessage;
