@@ -244,6 +244,9 @@ pub enum InputType {
     Odom,
     /// geometry_msgs/PoseStamped on `motion/pose`.
     Pose,
+    /// sensor_msgs/Imu on `motion/imu`: orientation, angular velocity and specific force of the vessel at
+    /// its frame origin (the tank's offset adds the lever-arm terms).
+    Imu,
 }
 
 /// Motion input of the ROS 2 node.

@@ -61,6 +61,9 @@ enum Command {
         /// Also publish geometry_msgs/PoseStamped on `motion/pose`.
         #[arg(long)]
         pose: bool,
+        /// Also publish sensor_msgs/Imu on `motion/imu` (an IMU at the vessel's origin).
+        #[arg(long)]
+        imu: bool,
         /// Wait for this many subscribers on `motion/odom` before the first sample.
         #[arg(long, default_value_t = 0)]
         wait_for_subscribers: usize,
@@ -99,6 +102,7 @@ fn main() -> anyhow::Result<()> {
             rate,
             duration,
             pose,
+            imu,
             wait_for_subscribers,
             lockstep,
             start_stamp,
@@ -115,6 +119,7 @@ fn main() -> anyhow::Result<()> {
                     rate_hz: rate,
                     duration,
                     pose,
+                    imu,
                     wait_for_subscribers,
                     lockstep,
                     start_stamp,

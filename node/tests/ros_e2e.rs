@@ -72,17 +72,28 @@ fn csv(path: &std::path::Path) -> Vec<Vec<f64>> {
 
 #[test]
 fn motion_to_node_to_subscriber_matches_slosh_run() {
-    if !common::in_private_netns("motion_to_node_to_subscriber_matches_slosh_run") {
-        return;
+    if common::in_private_netns("motion_to_node_to_subscriber_matches_slosh_run") {
+        compare_with_run("odom", 17);
     }
-    let dir = common::tmp("ros-e2e");
+}
+
+#[test]
+fn imu_driven_node_matches_slosh_run() {
+    if common::in_private_netns("imu_driven_node_matches_slosh_run") {
+        compare_with_run("imu", 19);
+    }
+}
+
+/// `slosh motion` → `slosh node` (input `kind`) → this subscriber, against `slosh run` on the same motion.
+fn compare_with_run(kind: &str, domain_id: u16) {
+    let dir = common::tmp(&format!("ros-e2e-{kind}"));
     let case = dir.join("case.yaml");
     std::fs::write(&case, common::small_case(EXTRA)).unwrap();
-    let domain = "17";
-    std::env::set_var("ROS_DOMAIN_ID", domain);
+    let domain = domain_id.to_string();
+    let domain = domain.as_str();
 
     // The subscriber first, so it sees every output.
-    let ctx = Context::with_options(ContextOptions::new().domain_id(17)).unwrap();
+    let ctx = Context::with_options(ContextOptions::new().domain_id(domain_id)).unwrap();
     let mut node = ctx
         .new_node(
             NodeName::new("/", "e2e_listener").unwrap(),

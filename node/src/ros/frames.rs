@@ -82,10 +82,25 @@ impl Frames {
     ) -> (Vector3<f64>, UnitQuaternion<f64>) {
         let p = self.world * position;
         // Vessel FLU body → ENU world: world conversion · received (FRD/FLU body → world) · FLU → body.
-        let r = UnitQuaternion::from_rotation_matrix(&self.world)
-            * orientation
-            * UnitQuaternion::from_rotation_matrix(&self.body.inverse());
+        let r = self.vessel_orientation(orientation);
         (p + r * self.offset, r * self.mount)
+    }
+
+    /// The vessel's orientation (FLU body → ENU world) from one received in the configured conventions.
+    pub fn vessel_orientation(&self, orientation: UnitQuaternion<f64>) -> UnitQuaternion<f64> {
+        UnitQuaternion::from_rotation_matrix(&self.world)
+            * orientation
+            * UnitQuaternion::from_rotation_matrix(&self.body.inverse())
+    }
+
+    /// A vector in the vessel's received body frame, in FLU.
+    pub fn body_vector(&self, v: Vector3<f64>) -> Vector3<f64> {
+        self.body * v
+    }
+
+    /// Where the tank origin sits in the vessel's FLU frame, and how the tank is turned on it.
+    pub fn mount(&self) -> (Vector3<f64>, UnitQuaternion<f64>) {
+        (self.offset, self.mount)
     }
 
     /// The six coordinates the solver's motion uses: x, y, z, then roll, pitch, yaw (z-y'-x'').

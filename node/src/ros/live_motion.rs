@@ -6,8 +6,9 @@ use sph::motion::{Dof6Motion, RigidState, SampledMotion, TankMotion};
 use std::collections::VecDeque;
 use std::f64::consts::PI;
 
-/// Samples kept for interpolation.
-const WINDOW: usize = 24;
+/// Samples kept at least, and samples kept before the solver's time, for the spline's context.
+const KEEP: usize = 24;
+const KEEP_BEFORE: usize = 4;
 
 /// Why a sample was dropped.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -51,8 +52,8 @@ impl LiveMotion {
     pub fn new(limits: Limits) -> Self {
         Self {
             limits,
-            times: VecDeque::with_capacity(WINDOW + 1),
-            poses: VecDeque::with_capacity(WINDOW + 1),
+            times: VecDeque::with_capacity(KEEP + 1),
+            poses: VecDeque::with_capacity(KEEP + 1),
             spline: None,
         }
     }
@@ -102,17 +103,31 @@ impl LiveMotion {
         }
         self.times.push_back(t);
         self.poses.push_back(pose);
-        while self.times.len() > WINDOW {
+        self.refit();
+        Ok(())
+    }
+
+    /// Drops samples the solver, now at time `t`, no longer needs (a few before `t` stay, and at least 24 in
+    /// all): the window always covers the solver's time however far it lags behind the input.
+    pub fn forget_before(&mut self, t: f64) {
+        let mut dropped = false;
+        while self.times.len() > KEEP && self.times[KEEP_BEFORE] < t {
             self.times.pop_front();
             self.poses.pop_front();
+            dropped = true;
         }
+        if dropped {
+            self.refit();
+        }
+    }
+
+    fn refit(&mut self) {
         self.spline = if self.times.len() >= 2 {
             let poses: Vec<[f64; 6]> = self.poses.iter().copied().collect();
             SampledMotion::new(self.times.iter().copied().collect(), &poses).ok()
         } else {
             None
         };
-        Ok(())
     }
 
     /// Time of the newest sample.
@@ -217,7 +232,13 @@ mod tests {
             m.push(t, [a * (w * t).sin(), 0.0, 0.0, 0.0, 0.0, 0.0])
                 .unwrap();
         }
-        assert_eq!(m.samples(), WINDOW);
+        // Nothing is forgotten before the solver has moved on; then the window keeps a few samples before
+        // the solver's time, and at least KEEP.
+        assert_eq!(m.samples(), 200);
+        m.forget_before(1.5);
+        assert_eq!(m.samples(), 200 - 150 + KEEP_BEFORE);
+        m.forget_before(1.95);
+        assert_eq!(m.samples(), KEEP);
         let until = m.safe_until(3).unwrap();
         assert!((until - 1.96).abs() < 1e-9);
         let t = until - 0.005;

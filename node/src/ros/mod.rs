@@ -4,6 +4,8 @@
 pub mod args;
 pub mod cloud;
 pub mod frames;
+pub mod live;
+pub mod live_imu;
 pub mod live_motion;
 pub mod motion_pub;
 pub mod node;

@@ -13,6 +13,7 @@ use slosh_msgs::geometry_msgs::{
 };
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
+use slosh_msgs::sensor_msgs::Imu;
 use slosh_msgs::std_msgs::Header;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -26,6 +27,8 @@ pub struct MotionOptions {
     pub duration: f64,
     /// Also publish PoseStamped on `motion/pose`.
     pub pose: bool,
+    /// Also publish sensor_msgs/Imu on `motion/imu` (an IMU at the vessel's frame origin).
+    pub imu: bool,
     /// Wait until this many subscribers are on `motion/odom` before the first sample (0: do not wait).
     pub wait_for_subscribers: usize,
     /// Publish ahead of a simulation's `/clock` by `lead` samples instead of pacing by the wall clock.
@@ -85,6 +88,43 @@ pub fn odometry(
     }
 }
 
+/// What an IMU at the vessel's origin reads at time t: orientation, body angular velocity, and specific force
+/// (acceleration minus gravity, in the body frame).
+pub fn imu(
+    motion: &dyn sph::motion::TankMotion,
+    t: f64,
+    stamp: Time,
+    body: &str,
+    gravity: f64,
+) -> Imu {
+    let s = motion.state(t);
+    let q = s.orientation;
+    let f =
+        q.inverse_transform_vector(&(s.acceleration - nalgebra::Vector3::new(0.0, 0.0, -gravity)));
+    let v = |v: nalgebra::Vector3<f64>| Vector3 {
+        x: v.x,
+        y: v.y,
+        z: v.z,
+    };
+    Imu {
+        header: Header {
+            stamp,
+            frame_id: body.into(),
+        },
+        orientation: Quaternion {
+            x: q.i,
+            y: q.j,
+            z: q.k,
+            w: q.w,
+        },
+        orientation_covariance: [0.0; 9],
+        angular_velocity: v(s.angular_velocity),
+        angular_velocity_covariance: [0.0; 9],
+        linear_acceleration: v(f),
+        linear_acceleration_covariance: [0.0; 9],
+    }
+}
+
 /// Publishes until the duration is reached or SIGINT/SIGTERM.
 pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<()> {
     if !(opts.rate_hz.is_finite() && opts.rate_hz > 0.0) {
@@ -132,6 +172,16 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
     } else {
         None
     };
+    let pub_imu = if opts.imu {
+        Some(super::publisher::<Imu>(
+            &mut node,
+            &names,
+            "motion/imu",
+            &qos,
+        )?)
+    } else {
+        None
+    };
     let clock = if opts.lockstep {
         Some(super::subscription::<Clock>(
             &mut node,
@@ -142,7 +192,12 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
     } else {
         None
     };
-    let odom_topic = names.resolve("motion/odom")?;
+    // The topic whose subscribers are waited for: the first one published.
+    let odom_topic = names.resolve(if opts.imu && !opts.pose {
+        "motion/imu"
+    } else {
+        "motion/odom"
+    })?;
     if opts.wait_for_subscribers > 0 {
         eprintln!(
             "slosh motion: waiting for {} subscriber(s) on {odom_topic}",
@@ -201,6 +256,13 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
         }
         let stamp = Time::from_secs_f64(start_stamp + t);
         let odom = odometry(motion.as_ref(), t, stamp, "odom", "base_link");
+        if let Some(p) = &pub_imu {
+            let m = imu(motion.as_ref(), t, stamp, "base_link", cfg.config.gravity);
+            match p.publish(m) {
+                Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => {}
+                Err(e) => anyhow::bail!("publishing motion/imu: {e:?}"),
+            }
+        }
         if let Some(p) = &pub_pose {
             let ps = PoseStamped {
                 header: odom.header.clone(),

@@ -4,21 +4,22 @@
 
 use super::args::{Names, RosArgs};
 use super::frames::Frames;
-use super::live_motion::{Limits, LiveMotion};
+use super::live::{Live, Reading};
+use super::live_motion::Limits;
 use super::pacing::Pacing;
 use crate::config::{InputType, Loaded, RealtimeMode, StampSource};
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::UnitQuaternion;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile, ServiceMapping, ServiceTypeName};
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
 use slosh_msgs::geometry_msgs::{
-    Point, Pose, PoseStamped, Quaternion as QuatMsg, Transform, TransformStamped,
-    Vector3 as Vec3Msg, Wrench, WrenchStamped,
+    Point, PoseStamped, Quaternion as QuatMsg, Transform, TransformStamped, Vector3 as Vec3Msg,
+    Wrench, WrenchStamped,
 };
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
-use slosh_msgs::sensor_msgs::PointCloud2;
+use slosh_msgs::sensor_msgs::{Imu, PointCloud2};
 use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
 use slosh_msgs::std_msgs::Header;
 use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
@@ -179,16 +180,6 @@ fn static_transforms(cfg: &Loaded, params: &SimParams, stamp: Time) -> TFMessage
     TFMessage { transforms }
 }
 
-fn pose_of(p: &Pose) -> (Vector3<f64>, UnitQuaternion<f64>) {
-    let o = &p.orientation;
-    let q = Quaternion::new(o.w, o.x, o.y, o.z);
-    // A zero quaternion (an unset orientation) normalises to NaN, which the sample check rejects by name.
-    (
-        Vector3::new(p.position.x, p.position.y, p.position.z),
-        UnitQuaternion::new_unchecked(q / q.norm()),
-    )
-}
-
 /// Counters reported in diagnostics.
 #[derive(Debug, Default, Clone)]
 struct Counters {
@@ -202,20 +193,35 @@ struct Counters {
 enum Input {
     Odom(ros2_client::Subscription<Odometry>),
     Pose(ros2_client::Subscription<PoseStamped>),
+    Imu(ros2_client::Subscription<Imu>),
 }
 
 impl Input {
-    /// The next received sample: (header stamp, pose).
-    fn take(&self) -> anyhow::Result<Option<(Time, Pose)>> {
+    /// The topic, before resolution.
+    fn topic(kind: InputType) -> &'static str {
+        match kind {
+            InputType::Odom => "motion/odom",
+            InputType::Pose => "motion/pose",
+            InputType::Imu => "motion/imu",
+        }
+    }
+
+    /// The next received sample: (header stamp, reading).
+    fn take(&self) -> anyhow::Result<Option<(Time, Reading)>> {
+        let err = |what: &str, e: ros2_client::ReadError| anyhow::anyhow!("reading {what}: {e:?}");
         Ok(match self {
             Input::Odom(s) => s
                 .take()
-                .map_err(|e| anyhow::anyhow!("reading motion/odom: {e:?}"))?
-                .map(|(m, _)| (m.header.stamp, m.pose.pose)),
+                .map_err(|e| err("motion/odom", e))?
+                .map(|(m, _)| (m.header.stamp, Reading::Pose(m.pose.pose))),
             Input::Pose(s) => s
                 .take()
-                .map_err(|e| anyhow::anyhow!("reading motion/pose: {e:?}"))?
-                .map(|(m, _)| (m.header.stamp, m.pose)),
+                .map_err(|e| err("motion/pose", e))?
+                .map(|(m, _)| (m.header.stamp, Reading::Pose(m.pose))),
+            Input::Imu(s) => s
+                .take()
+                .map_err(|e| err("motion/imu", e))?
+                .map(|(m, _)| (m.header.stamp, Reading::Imu(Box::new(m)))),
         })
     }
 }
@@ -248,7 +254,9 @@ pub fn run(
         )
         .map_err(|e| anyhow::anyhow!("cannot create the node: {e:?}"))?;
 
+    let topic = Input::topic(c.input.kind);
     let input = match c.input.kind {
+        InputType::Imu => Input::Imu(super::subscription(&mut node, &names, topic, &qos_input())?),
         InputType::Odom => Input::Odom(super::subscription(
             &mut node,
             &names,
@@ -325,10 +333,16 @@ pub fn run(
         .map_err(|e| anyhow::anyhow!("service ~/pause: {e:?}"))?;
 
     let frames = Frames::new(c.input.world_frame, c.input.body_frame, c.frames.tank_pose);
-    let mut motion = LiveMotion::new(Limits {
-        max_speed: c.input.max_speed,
-        max_rotation_rate: c.input.max_rotation_rate,
-    });
+    let imu = c.input.kind == InputType::Imu;
+    let mut motion = Live::new(
+        imu,
+        Limits {
+            max_speed: c.input.max_speed,
+            max_rotation_rate: c.input.max_rotation_rate,
+        },
+        &frames,
+        params.gravity,
+    );
     let mut sim = sph::build(params.clone())?;
     let counts = sim.counts();
     let full_name = format!(
@@ -356,10 +370,7 @@ pub fn run(
             counts.fluid,
             counts.boundary,
             c.realtime.mode,
-            names.resolve(match c.input.kind {
-                InputType::Odom => "motion/odom",
-                InputType::Pose => "motion/pose",
-            })?
+            names.resolve(topic)?
         ),
     );
 
@@ -376,7 +387,8 @@ pub fn run(
     let mut tf_sent = false;
     let dt_cap = params.solver.dt_max;
     let mut error: Option<String> = None;
-    let mut pending: Vec<(Time, Pose)> = Vec::with_capacity(64);
+    let mut pending: Vec<(Time, Reading)> = Vec::with_capacity(64);
+    let mut last_real = 0.0;
     let mut paused = false;
     // After a reset or a resume the next sample is placed at the current simulation time.
     let mut rebase = false;
@@ -389,7 +401,7 @@ pub fn run(
         // 0. Services: ~/reset starts the liquid again at rest, ~/pause freezes the simulation.
         while let Ok(Some((id, _))) = srv_reset.receive_request() {
             sim = sph::build(params.clone())?;
-            motion = LiveMotion::new(limits);
+            motion = Live::new(imu, limits, &frames, params.gravity);
             next_output = 0;
             next_cloud = 0;
             rebase = t0.is_some();
@@ -415,7 +427,7 @@ pub fn run(
             } else {
                 paused = false;
                 // Resume from the current input without catching up on the paused stretch.
-                motion = LiveMotion::new(limits);
+                motion = Live::new(imu, limits, &frames, params.gravity);
                 rebase = t0.is_some();
                 format!("resumed at t = {:.4} s", sim.time())
             };
@@ -436,7 +448,7 @@ pub fn run(
         while let Some(sample) = input.take()? {
             pending.push(sample);
         }
-        for (stamp, pose) in pending.drain(..) {
+        for (stamp, reading) in pending.drain(..) {
             let w = wall();
             let ts = match c.input.stamp {
                 StampSource::Header => stamp.as_secs_f64(),
@@ -450,10 +462,9 @@ pub fn run(
                 t0 = Some(ts - sim.time());
             }
             let base = *t0.get_or_insert(ts);
-            let (p, q) = pose_of(&pose);
-            let coords = frames.tank_coordinates(p, q);
-            match motion.push(ts - base, coords) {
+            match motion.push(ts - base, &reading, &frames) {
                 Ok(()) => {
+                    last_real = ts - base;
                     counters.accepted += 1;
                     pacing.input(w);
                     got = true;
@@ -509,11 +520,7 @@ pub fn run(
         }
         // 2. No input for too long (real-time mode): hold the last pose, at rest, and say so.
         if c.realtime.mode == RealtimeMode::Realtime {
-            if let (Some(age), Some(last), Some(pose)) = (
-                pacing.input_age(wall()),
-                motion.newest(),
-                motion.last_pose(),
-            ) {
+            if let (Some(age), Some(newest)) = (pacing.input_age(wall()), motion.newest()) {
                 if age > c.motion_timeout_s {
                     if !holding {
                         holding = true;
@@ -523,15 +530,16 @@ pub fn run(
                             &format!("no motion input for {age:.2} s (motion_timeout_s = {}): holding the last pose", c.motion_timeout_s),
                         );
                     }
-                    // Samples of the held pose keep the simulation going in real time.
-                    let t_hold = last + 0.02;
-                    if motion.push(t_hold, pose).is_ok() {
+                    // Held samples follow the wall clock from the last real one, at most 100 per second.
+                    let t_hold = last_real + age;
+                    if t_hold > newest + 0.01 && motion.hold(t_hold) {
                         got = true;
                     }
                 }
             }
         }
         // 3. Step up to what the input allows.
+        motion.forget_before(sim.time());
         if let Some(sc) = &sub_clock {
             while let Ok(Some((m, _))) = sc.take() {
                 ros_time = Some(m.clock.as_secs_f64());
