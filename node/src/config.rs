@@ -265,6 +265,9 @@ pub struct InputCfg {
     pub max_rotation_rate: f64,
     /// Take sample times from the header stamp (`header`) or from the arrival time (`receive`).
     pub stamp: StampSource,
+    /// Also subscribe `motion/accel` (geometry_msgs/AccelStamped, vessel body frame) and use its measured
+    /// accelerations instead of the pose spline's (with `odom` or `pose` input).
+    pub accel: bool,
 }
 
 impl Default for InputCfg {
@@ -277,6 +280,7 @@ impl Default for InputCfg {
             max_speed: 50.0,
             max_rotation_rate: 5.0,
             stamp: StampSource::Header,
+            accel: false,
         }
     }
 }

@@ -64,6 +64,9 @@ enum Command {
         /// Also publish sensor_msgs/Imu on `motion/imu` (an IMU at the vessel's origin).
         #[arg(long)]
         imu: bool,
+        /// Also publish geometry_msgs/AccelStamped on `motion/accel` (body frame).
+        #[arg(long)]
+        accel: bool,
         /// Wait for this many subscribers on `motion/odom` before the first sample.
         #[arg(long, default_value_t = 0)]
         wait_for_subscribers: usize,
@@ -103,6 +106,7 @@ fn main() -> anyhow::Result<()> {
             duration,
             pose,
             imu,
+            accel,
             wait_for_subscribers,
             lockstep,
             start_stamp,
@@ -120,6 +124,7 @@ fn main() -> anyhow::Result<()> {
                     duration,
                     pose,
                     imu,
+                    accel,
                     wait_for_subscribers,
                     lockstep,
                     start_stamp,

@@ -84,7 +84,14 @@ fn imu_driven_node_matches_slosh_run() {
     }
 }
 
-/// `slosh motion` → `slosh node` (input `kind`) → this subscriber, against `slosh run` on the same motion.
+#[test]
+fn odom_with_measured_accelerations_matches_slosh_run() {
+    if common::in_private_netns("odom_with_measured_accelerations_matches_slosh_run") {
+        compare_with_run("accel", 21);
+    }
+}
+
+/// `slosh motion` → `slosh node` (input `kind`: odom, imu, or accel = odom + AccelStamped) → this subscriber, against `slosh run` on the same motion.
 fn compare_with_run(kind: &str, domain_id: u16) {
     let dir = common::tmp(&format!("ros-e2e-{kind}"));
     let case = dir.join("case.yaml");
@@ -589,5 +596,110 @@ fn ros_domain_id_takes_effect() {
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("ROS_DOMAIN_ID=ship"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly() {
+    if !common::in_private_netns(
+        "input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly",
+    ) {
+        return;
+    }
+    let dir = common::tmp("ros-timeout");
+    let case = dir.join("case.yaml");
+    std::fs::write(
+        &case,
+        common::small_case("    motion_timeout_s: 0.5\n    diagnostics_rate_hz: 10.0\n"),
+    )
+    .unwrap();
+    let ctx = Context::with_options(ContextOptions::new().domain_id(43)).unwrap();
+    let mut node = ctx
+        .new_node(
+            NodeName::new("/", "e2e_timeout").unwrap(),
+            NodeOptions::new().enable_rosout(false),
+        )
+        .unwrap();
+    let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
+    let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
+    let mut proc = Kill(
+        slosh()
+            .args(["node", "--ros-args", "--params-file"])
+            .arg(&case)
+            .env("ROS_DOMAIN_ID", "43")
+            .spawn()
+            .unwrap(),
+    );
+    while node.subscription_count("/motion/odom") == 0 || node.publisher_count("/wrench") == 0 {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    // (newest wrench stamp, levels and messages of the diagnostics) over a stretch of wall time.
+    let watch = |secs: f64, last: &mut f64| {
+        let mut states = Vec::new();
+        let start = Instant::now();
+        while start.elapsed().as_secs_f64() < secs {
+            while let Ok(Some((m, _))) = wrench.take() {
+                *last = last.max(m.header.stamp.as_secs_f64());
+            }
+            while let Ok(Some((m, _))) = diags.take() {
+                states.push((m.status[0].level, m.status[0].message.clone()));
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        states
+    };
+    let mut last = f64::NEG_INFINITY;
+    // 0.5 s of input in real time, then silence for 2 s.
+    for k in 0..25 {
+        let _ = odom.publish(rest_odometry(300.0 + k as f64 * 0.02));
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let states = watch(2.0, &mut last);
+    assert!(
+        states
+            .iter()
+            .any(|(l, m)| *l == 2 && m.contains("no motion input")),
+        "no ERROR diagnostics while input is missing: {states:?}"
+    );
+    // The simulation went on, holding the last pose, about in real time past the last sample (300.48 s).
+    assert!(
+        last > 300.48 + 1.0,
+        "outputs stopped at {last} while holding"
+    );
+    // Input returns (its stamps continue the wall-clock timeline): diagnostics recover while it flows.
+    let mut states = Vec::new();
+    for k in 0..50 {
+        let _ = odom.publish(rest_odometry(302.6 + k as f64 * 0.02));
+        states.extend(watch(0.02, &mut last));
+    }
+    assert!(
+        states
+            .iter()
+            .skip(3)
+            .any(|(l, m)| *l == 0 && m == "running"),
+        "diagnostics did not recover: {states:?}"
+    );
+    // SIGTERM: a clean exit, promptly.
+    let pid = proc.0.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let start = Instant::now();
+    let status = loop {
+        if let Some(st) = proc.0.try_wait().unwrap() {
+            break st;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(5),
+            "slosh node ignored SIGTERM"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(status.success(), "exit after SIGTERM: {status}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -20,8 +20,44 @@ pub enum Reading {
 /// Received motion of either kind.
 #[derive(Debug)]
 pub enum Live {
-    Pose(LiveMotion),
+    Pose(LiveMotion, Accel),
     Imu(LiveImu),
+}
+
+/// Measured accelerations of the vessel (geometry_msgs/AccelStamped on `motion/accel`, body frame), used
+/// instead of the pose spline's second derivatives where they cover the time asked for.
+#[derive(Debug, Default)]
+pub struct Accel {
+    /// (t, linear m/s², angular rad/s²), vessel FLU frame.
+    samples: std::collections::VecDeque<(f64, Vector3<f64>, Vector3<f64>)>,
+    lever: Vector3<f64>,
+    mount: UnitQuaternion<f64>,
+}
+
+impl Accel {
+    /// (linear, angular) acceleration at t, linearly interpolated, if samples bracket t.
+    fn at(&self, t: f64) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let i = self.samples.partition_point(|s| s.0 <= t);
+        if i == 0 || i == self.samples.len() {
+            return None;
+        }
+        let ((ta, la, aa), (tb, lb, ab)) = (self.samples[i - 1], self.samples[i]);
+        let u = (t - ta) / (tb - ta);
+        Some((la.lerp(&lb, u), aa.lerp(&ab, u)))
+    }
+
+    /// The tank's state with the measured accelerations: a_tank = R_v (a + α × r + ω × (ω × r)).
+    fn apply(&self, t: f64, mut s: RigidState) -> RigidState {
+        let Some((a, alpha)) = self.at(t) else {
+            return s;
+        };
+        let r = self.lever;
+        let w_v = self.mount * s.angular_velocity;
+        let r_v = s.orientation * self.mount.inverse();
+        s.acceleration = r_v * (a + alpha.cross(&r) + w_v.cross(&w_v.cross(&r)));
+        s.angular_acceleration = self.mount.inverse() * alpha;
+        s
+    }
 }
 
 fn unit(q: &QuatMsg) -> UnitQuaternion<f64> {
@@ -37,18 +73,55 @@ fn vector(v: &Vec3Msg) -> Vector3<f64> {
 impl Live {
     /// Empty input of the kind `imu` says, for a tank mounted as `frames` says.
     pub fn new(imu: bool, limits: Limits, frames: &Frames, gravity: f64) -> Self {
+        let (lever, mount) = frames.mount();
         if imu {
-            let (lever, mount) = frames.mount();
             Live::Imu(LiveImu::new(limits, gravity, lever, mount))
         } else {
-            Live::Pose(LiveMotion::new(limits))
+            Live::Pose(
+                LiveMotion::new(limits),
+                Accel {
+                    samples: Default::default(),
+                    lever,
+                    mount,
+                },
+            )
         }
+    }
+
+    /// Adds a measured acceleration (linear, angular; received body frame) at time `t` (pose input only).
+    pub fn push_accel(
+        &mut self,
+        t: f64,
+        linear: &Vec3Msg,
+        angular: &Vec3Msg,
+        frames: &Frames,
+    ) -> Result<(), Rejected> {
+        let Live::Pose(_, acc) = self else {
+            return Ok(());
+        };
+        let (l, a) = (vector(linear), vector(angular));
+        if !(l.iter().chain(a.iter()).all(|v| v.is_finite())) {
+            return Err(Rejected::NotFinite {
+                what: "acceleration",
+            });
+        }
+        if let Some(&(t0, _, _)) = acc.samples.back() {
+            if t <= t0 {
+                return Err(Rejected::OutOfOrder {
+                    time: t,
+                    newest: t0,
+                });
+            }
+        }
+        acc.samples
+            .push_back((t, frames.body_vector(l), frames.body_vector(a)));
+        Ok(())
     }
 
     /// Adds a sample at time `t`, converted by `frames`.
     pub fn push(&mut self, t: f64, r: &Reading, frames: &Frames) -> Result<(), Rejected> {
         match (self, r) {
-            (Live::Pose(m), Reading::Pose(p)) => {
+            (Live::Pose(m, _), Reading::Pose(p)) => {
                 let position = Vector3::new(p.position.x, p.position.y, p.position.z);
                 m.push(t, frames.tank_coordinates(position, unit(&p.orientation)))
             }
@@ -67,7 +140,7 @@ impl Live {
     /// Extends the motion to `t` holding the last pose at rest; false if there is nothing to hold.
     pub fn hold(&mut self, t: f64) -> bool {
         match self {
-            Live::Pose(m) => m.last_pose().is_some_and(|p| m.push(t, p).is_ok()),
+            Live::Pose(m, _) => m.last_pose().is_some_and(|p| m.push(t, p).is_ok()),
             Live::Imu(m) => m.held().is_some_and(|s| m.push(t, s).is_ok()),
         }
     }
@@ -75,21 +148,26 @@ impl Live {
     /// Drops samples older than the solver's time `t` needs.
     pub fn forget_before(&mut self, t: f64) {
         match self {
-            Live::Pose(m) => m.forget_before(t),
+            Live::Pose(m, acc) => {
+                m.forget_before(t);
+                while acc.samples.len() > 2 && acc.samples[1].0 < t {
+                    acc.samples.pop_front();
+                }
+            }
             Live::Imu(m) => m.forget_before(t),
         }
     }
 
     pub fn newest(&self) -> Option<f64> {
         match self {
-            Live::Pose(m) => m.newest(),
+            Live::Pose(m, _) => m.newest(),
             Live::Imu(m) => m.newest(),
         }
     }
 
     pub fn safe_until(&self, delay_samples: usize) -> Option<f64> {
         match self {
-            Live::Pose(m) => m.safe_until(delay_samples),
+            Live::Pose(m, _) => m.safe_until(delay_samples),
             Live::Imu(m) => m.safe_until(delay_samples),
         }
     }
@@ -98,12 +176,103 @@ impl Live {
 impl TankMotion for Live {
     fn state(&self, t: f64) -> RigidState {
         match self {
-            Live::Pose(m) => m.state(t),
+            Live::Pose(m, acc) => acc.apply(t, m.state(t)),
             Live::Imu(m) => m.state(t),
         }
     }
 
     fn end_time(&self) -> f64 {
         self.newest().unwrap_or(0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ros::frames::{BodyFrame, TankPose, WorldFrame};
+    use sph::motion::{Dof6Motion, RegularDof, RegularMotion};
+
+    #[test]
+    fn measured_accelerations_replace_the_splines_and_carry_the_lever_arm() {
+        let dof = |amplitude, period| RegularDof {
+            amplitude,
+            period,
+            phase: 0.2,
+        };
+        let zero = dof(0.0, 0.0);
+        let m = RegularMotion {
+            dofs: [
+                dof(0.3, 3.0),
+                zero,
+                dof(0.2, 4.0),
+                dof(0.1, 5.0),
+                dof(0.05, 7.0),
+                zero,
+            ],
+            ramp: 0.0,
+        };
+        let tank = TankPose {
+            x: 3.0,
+            z: 2.0,
+            ..Default::default()
+        };
+        let frames = Frames::new(WorldFrame::Enu, BodyFrame::Flu, tank);
+        let limits = Limits {
+            max_speed: 50.0,
+            max_rotation_rate: 5.0,
+        };
+        let mut live = Live::new(false, limits, &frames, 9.81);
+        // Poses only at 5 Hz (a coarse spline); accelerations at 50 Hz.
+        let v3 = |v: Vector3<f64>| Vec3Msg {
+            x: v.x,
+            y: v.y,
+            z: v.z,
+        };
+        for k in 0..=100 {
+            let t = k as f64 * 0.02;
+            let s = m.dof(t).to_state();
+            if k % 10 == 0 {
+                let q = s.orientation;
+                let pose = Pose {
+                    position: slosh_msgs::geometry_msgs::Point {
+                        x: s.position.x,
+                        y: s.position.y,
+                        z: s.position.z,
+                    },
+                    orientation: QuatMsg {
+                        x: q.i,
+                        y: q.j,
+                        z: q.k,
+                        w: q.w,
+                    },
+                };
+                live.push(t, &Reading::Pose(pose), &frames).unwrap();
+            }
+            let a_body = s.orientation.inverse_transform_vector(&s.acceleration);
+            live.push_accel(t, &v3(a_body), &v3(s.angular_acceleration), &frames)
+                .unwrap();
+        }
+        let t = 1.01;
+        let s = m.dof(t).to_state();
+        let r = Vector3::new(3.0, 0.0, 2.0);
+        let w = s.angular_velocity;
+        let exact = s.acceleration
+            + s.orientation * (s.angular_acceleration.cross(&r) + w.cross(&w.cross(&r)));
+        let got = live.state(t);
+        // The spline of 5 Hz poses alone is far off; with the measured accelerations it is close.
+        let Live::Pose(spline, _) = &live else {
+            unreachable!()
+        };
+        let coarse = spline.state(t).acceleration;
+        assert!(
+            (got.acceleration - exact).norm() < 0.02 * exact.norm(),
+            "{} vs {exact}",
+            got.acceleration
+        );
+        assert!((coarse - exact).norm() > 5.0 * (got.acceleration - exact).norm());
+        assert!(
+            (got.angular_acceleration - s.angular_acceleration).norm()
+                < 0.02 * s.angular_acceleration.norm()
+        );
     }
 }

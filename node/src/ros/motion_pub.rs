@@ -9,7 +9,8 @@ use ros2_client::qos::{History, WhenFull};
 use ros2_client::{NodeName, NodeOptions, QosProfile};
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::geometry_msgs::{
-    Point, Pose, PoseStamped, PoseWithCovariance, Quaternion, Twist, TwistWithCovariance, Vector3,
+    Accel, AccelStamped, Point, Pose, PoseStamped, PoseWithCovariance, Quaternion, Twist,
+    TwistWithCovariance, Vector3,
 };
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
@@ -29,6 +30,8 @@ pub struct MotionOptions {
     pub pose: bool,
     /// Also publish sensor_msgs/Imu on `motion/imu` (an IMU at the vessel's frame origin).
     pub imu: bool,
+    /// Also publish geometry_msgs/AccelStamped on `motion/accel` (body frame).
+    pub accel: bool,
     /// Wait until this many subscribers are on `motion/odom` before the first sample (0: do not wait).
     pub wait_for_subscribers: usize,
     /// Publish ahead of a simulation's `/clock` by `lead` samples instead of pacing by the wall clock.
@@ -182,6 +185,16 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
     } else {
         None
     };
+    let pub_accel = if opts.accel {
+        Some(super::publisher::<AccelStamped>(
+            &mut node,
+            &names,
+            "motion/accel",
+            &qos,
+        )?)
+    } else {
+        None
+    };
     let clock = if opts.lockstep {
         Some(super::subscription::<Clock>(
             &mut node,
@@ -256,6 +269,29 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
         }
         let stamp = Time::from_secs_f64(start_stamp + t);
         let odom = odometry(motion.as_ref(), t, stamp, "odom", "base_link");
+        if let Some(p) = &pub_accel {
+            let st = motion.state(t);
+            let a = st.orientation.inverse_transform_vector(&st.acceleration);
+            let v = |v: nalgebra::Vector3<f64>| Vector3 {
+                x: v.x,
+                y: v.y,
+                z: v.z,
+            };
+            let m = AccelStamped {
+                header: Header {
+                    stamp,
+                    frame_id: "base_link".into(),
+                },
+                accel: Accel {
+                    linear: v(a),
+                    angular: v(st.angular_acceleration),
+                },
+            };
+            match p.publish(m) {
+                Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => {}
+                Err(e) => anyhow::bail!("publishing motion/accel: {e:?}"),
+            }
+        }
         if let Some(p) = &pub_imu {
             let m = imu(motion.as_ref(), t, stamp, "base_link", cfg.config.gravity);
             match p.publish(m) {

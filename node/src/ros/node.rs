@@ -14,8 +14,8 @@ use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile, ServiceMapping, 
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
 use slosh_msgs::geometry_msgs::{
-    Point, PoseStamped, Quaternion as QuatMsg, Transform, TransformStamped, Vector3 as Vec3Msg,
-    Wrench, WrenchStamped,
+    AccelStamped, Point, PoseStamped, Quaternion as QuatMsg, Transform, TransformStamped,
+    Vector3 as Vec3Msg, Wrench, WrenchStamped,
 };
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
@@ -270,6 +270,17 @@ pub fn run(
             &qos_input(),
         )?),
     };
+    let sub_accel: Option<ros2_client::Subscription<AccelStamped>> =
+        if c.input.accel && c.input.kind != InputType::Imu {
+            Some(super::subscription(
+                &mut node,
+                &names,
+                "motion/accel",
+                &qos_input(),
+            )?)
+        } else {
+            None
+        };
     let out_qos = qos_outputs();
     let pub_wrench: Publisher<WrenchStamped> =
         super::publisher(&mut node, &names, "wrench", &out_qos)?;
@@ -486,6 +497,15 @@ pub fn run(
                             ),
                         );
                     }
+                }
+            }
+        }
+        if let (Some(sa), Some(base)) = (&sub_accel, t0) {
+            while let Ok(Some((m, _))) = sa.take() {
+                let t = m.header.stamp.as_secs_f64() - base;
+                if let Err(e) = motion.push_accel(t, &m.accel.linear, &m.accel.angular, &frames) {
+                    counters.rejected += 1;
+                    counters.last_reject = format!("motion/accel: {e}");
                 }
             }
         }
