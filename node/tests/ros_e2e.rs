@@ -675,11 +675,13 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
         let _ = odom.publish(rest_odometry(302.6 + k as f64 * 0.02));
         states.extend(watch(0.02, &mut last));
     }
+    // Recovered: the missing-input ERROR gives way to OK ("running") or, on a loaded machine, WARN ("behind
+    // real time").
     assert!(
         states
             .iter()
             .skip(3)
-            .any(|(l, m)| *l == 0 && m == "running"),
+            .any(|(l, m)| *l <= 1 && !m.contains("no motion input")),
         "diagnostics did not recover: {states:?}"
     );
     // SIGTERM: a clean exit, promptly.

@@ -761,13 +761,12 @@ fn diagnostics(
     state: &str,
     wall: f64,
 ) -> DiagnosticArray {
-    let level = if stamp.is_none() || pacing.behind() {
-        DiagnosticStatus::WARN
-    } else if state.starts_with("running") {
+    let level = if state == "running" {
         DiagnosticStatus::OK
-    } else if state.starts_with("behind") {
+    } else if stamp.is_none() || state.starts_with("behind") || state.starts_with("paused") {
         DiagnosticStatus::WARN
     } else {
+        // No motion input (holding the last pose), or the solver stopped.
         DiagnosticStatus::ERROR
     };
     let kv = |k: &str, v: String| KeyValue {
