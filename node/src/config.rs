@@ -191,6 +191,9 @@ pub struct RunConfig {
     /// (rmw_cyclonedds) or `basic`.
     #[serde(default)]
     pub service_mapping: ServiceMappingCfg,
+    /// Recording to a rosbag2 MCAP folder (`record.path`; empty: off).
+    #[serde(default)]
+    pub record: crate::record::RecordCfg,
     /// The `particles` PointCloud2 output of `slosh node` (off by default).
     #[serde(default)]
     pub particles: ParticlesCfg,

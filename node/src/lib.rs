@@ -8,5 +8,6 @@ pub mod bench;
 pub mod config;
 pub mod motion_source;
 pub mod output;
+pub mod record;
 pub mod ros;
 pub mod runner;

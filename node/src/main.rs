@@ -39,6 +39,11 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Work on recorded bags.
+    Bag {
+        #[command(subcommand)]
+        command: BagCommand,
+    },
     /// Run as a ROS 2 node: `slosh node --ros-args --params-file CASE.yaml [-p name:=value] [-r from:=to]`.
     Node {
         /// Stop after this many simulated seconds (default: run until SIGINT/SIGTERM).
@@ -83,9 +88,43 @@ enum Command {
     },
 }
 
+#[derive(Subcommand)]
+enum BagCommand {
+    /// Make a whole bag from an unfinished or damaged one (e.g. after the recorder was killed): every message
+    /// of its complete chunks goes into a new bag folder.
+    Repair {
+        /// The damaged bag folder or .mcap file.
+        bag: PathBuf,
+        /// The new bag folder (default: BAG_repaired).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Bag {
+            command: BagCommand::Repair { bag, out },
+        } => {
+            let out = out.unwrap_or_else(|| {
+                let name = bag
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                bag.with_file_name(format!("{name}_repaired"))
+            });
+            let r = slosh_node::record::repair(&bag, &out)?;
+            println!(
+                "recovered {} messages on {} topics into {}{}",
+                r.messages,
+                r.topics,
+                out.display(),
+                r.stopped
+                    .map(|e| format!(" (the input ends early: {e})"))
+                    .unwrap_or_default()
+            );
+        }
         Command::Node { duration, args } => {
             let (plain, ros_args) = ros::args::parse(&args)?;
             if plain.len() > 1 {

@@ -4,8 +4,10 @@
 use crate::config::Loaded;
 use crate::motion_source;
 use crate::output::{write_summary, CsvOutputs, Summary};
+use crate::record::{record_state, RecordError, Recorder};
 use indicatif::{ProgressBar, ProgressStyle};
 use sph::motion::TankMotion;
+use sph::params::SimParams;
 use sph::Solver;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -18,6 +20,12 @@ pub enum RunError {
     Motion(#[from] motion_source::MotionError),
     #[error("{0}")]
     Output(#[from] std::io::Error),
+    #[error(transparent)]
+    Record(#[from] RecordError),
+    #[error(
+        "interrupted at t = {time:.4} s; outputs so far (and the recording, finished) are in {dir}"
+    )]
+    Interrupted { time: f64, dir: String },
     #[error("solver stopped: {error} (outputs up to t = {time:.4} s are in {dir})")]
     Solver {
         error: sph::SimError,
@@ -57,17 +65,27 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
         .into());
     }
     let mut outputs = CsvOutputs::create(out, &params)?;
+    let mut recorder = if cfg.config.record.path.is_empty() {
+        None
+    } else {
+        Some(Recorder::create(&cfg.config.record, &cfg.parameters)?)
+    };
     let mut sim = sph::build(params.clone()).map_err(|e| RunError::Solver {
         error: e,
         time: 0.0,
         dir: out.display().to_string(),
     })?;
+    let stop = crate::ros::shutdown_flag().map_err(std::io::Error::other)?;
     let bar = progress_bar(opts.progress, duration);
     let start = Instant::now();
     let result = run_loop(
         sim.as_mut(),
         motion.as_ref(),
         &mut outputs,
+        recorder
+            .as_mut()
+            .map(|r| (r, &params, cfg.config.frames.tank.as_str())),
+        &stop,
         duration,
         cfg.config.output_rate_hz,
         &bar,
@@ -75,6 +93,10 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
     let wall = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     outputs.flush()?;
+    // The bag is finished on every path, also when the solver stopped.
+    if let Some(mut r) = recorder {
+        r.finish()?;
+    }
     let (stats, counts) = (sim.stats(), sim.counts());
     let summary = Summary {
         dimension: params.dimension,
@@ -105,6 +127,11 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
             dir: out.display().to_string(),
         }),
         Err(LoopError::Io(e)) => Err(e.into()),
+        Err(LoopError::Record(e)) => Err(e.into()),
+        Err(LoopError::Interrupted(t)) => Err(RunError::Interrupted {
+            time: t,
+            dir: out.display().to_string(),
+        }),
     }
 }
 
@@ -114,12 +141,19 @@ enum LoopError {
     Solver(sph::SimError),
     #[error(transparent)]
     Io(std::io::Error),
+    #[error(transparent)]
+    Record(RecordError),
+    #[error("interrupted (SIGINT/SIGTERM) at t = {0:.4} s")]
+    Interrupted(f64),
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_loop(
     sim: &mut dyn Solver,
     motion: &dyn TankMotion,
     out: &mut CsvOutputs,
+    mut rec: Option<(&mut Recorder, &SimParams, &str)>,
+    stop: &std::sync::atomic::AtomicBool,
     duration: f64,
     rate: f64,
     bar: &ProgressBar,
@@ -133,10 +167,16 @@ fn run_loop(
         if t >= k as f64 / rate - 1e-9 {
             let o = sim.observe(motion).map_err(LoopError::Solver)?;
             out.write(&o).map_err(LoopError::Io)?;
+            if let Some((r, params, frame)) = rec.as_mut() {
+                record_state(r, params, frame, &o, motion).map_err(LoopError::Record)?;
+            }
             k = (t * rate + 1e-9).floor() as u64 + 1;
         }
         if t >= duration - 1e-9 {
             return Ok(());
+        }
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(LoopError::Interrupted(t));
         }
         sim.step(motion).map_err(LoopError::Solver)?;
         if last_draw.elapsed() > Duration::from_millis(200) {

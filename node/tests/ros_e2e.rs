@@ -129,6 +129,12 @@ fn compare_with_run(kind: &str, domain_id: u16) {
                 "-p",
                 "realtime.mode:=lockstep",
             ])
+            .args(["-p", &format!("record.path:={}", dir.join("bag").display())])
+            .args(match kind {
+                "accel" => ["-p", "input.accel:=true"],
+                "imu" => ["-p", "input.type:=imu"],
+                _ => ["-p", "input.type:=odom"],
+            })
             .env("ROS_DOMAIN_ID", domain)
             .stdout(Stdio::inherit())
             .stderr(Stdio::inherit())
@@ -159,6 +165,11 @@ fn compare_with_run(kind: &str, domain_id: u16) {
                 "--start-stamp",
                 &T0.to_string(),
             ])
+            .args(match kind {
+                "imu" => &["--imu"][..],
+                "accel" => &["--accel"][..],
+                _ => &[][..],
+            })
             .args(["--ros-args", "-r", "__ns:=/ship1"])
             .env("ROS_DOMAIN_ID", domain)
             .spawn()
@@ -271,6 +282,47 @@ fn compare_with_run(kind: &str, domain_id: u16) {
         worst_probe < 0.01,
         "probe elevations differ by {worst_probe} m"
     );
+
+    // The node's recording holds the motion as received and the outputs as published (third-party readers).
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/py/read_bag.py");
+    let out = Command::new(common::python())
+        .arg(script)
+        .arg(dir.join("bag"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bag: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let motion_topic = if kind == "imu" {
+        "/ship1/motion/imu"
+    } else {
+        "/ship1/motion/odom"
+    };
+    let n_motion = bag["rosbags"][motion_topic]["items"]
+        .as_array()
+        .map_or(0, Vec::len);
+    assert!(
+        n_motion as f64 >= DURATION * 50.0,
+        "{n_motion} motion samples recorded"
+    );
+    let bag_w = bag["rosbags"]["/ship1/wrench"]["items"].as_array().unwrap();
+    assert_eq!(
+        bag_w.len(),
+        got_w.len(),
+        "recorded and received wrench messages"
+    );
+    for (item, (t, w)) in bag_w.iter().zip(&got_w) {
+        assert!((item[0].as_f64().unwrap() - T0 - t).abs() < 1e-6);
+        let fx = item[1][0].as_f64().unwrap();
+        assert!(
+            (fx - w[0]).abs() <= 1e-12 * (1.0 + w[0].abs()),
+            "recorded fx {fx} vs received {}",
+            w[0]
+        );
+    }
 
     // Diagnostics arrive and carry the documented keys.
     let last = got_d.last().expect("no /diagnostics received");

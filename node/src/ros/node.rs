@@ -8,6 +8,7 @@ use super::live::{Live, Reading};
 use super::live_motion::Limits;
 use super::pacing::Pacing;
 use crate::config::{InputType, Loaded, RealtimeMode, StampSource};
+use crate::record::Recorder;
 use nalgebra::UnitQuaternion;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile, ServiceMapping, ServiceTypeName};
@@ -206,22 +207,41 @@ impl Input {
         }
     }
 
-    /// The next received sample: (header stamp, reading).
-    fn take(&self) -> anyhow::Result<Option<(Time, Reading)>> {
+    /// The next received sample: (header stamp, reading); recorded as received when `rec` is given.
+    fn take(&self, rec: Option<(&mut Recorder, &str)>) -> anyhow::Result<Option<(Time, Reading)>> {
         let err = |what: &str, e: ros2_client::ReadError| anyhow::anyhow!("reading {what}: {e:?}");
+        fn keep<M: slosh_msgs::RosMessage>(
+            rec: Option<(&mut Recorder, &str)>,
+            stamp: Time,
+            m: &M,
+        ) -> anyhow::Result<()> {
+            if let Some((r, topic)) = rec {
+                r.write(topic, stamp.as_secs_f64(), m)?;
+            }
+            Ok(())
+        }
         Ok(match self {
-            Input::Odom(s) => s
-                .take()
-                .map_err(|e| err("motion/odom", e))?
-                .map(|(m, _)| (m.header.stamp, Reading::Pose(m.pose.pose))),
-            Input::Pose(s) => s
-                .take()
-                .map_err(|e| err("motion/pose", e))?
-                .map(|(m, _)| (m.header.stamp, Reading::Pose(m.pose))),
-            Input::Imu(s) => s
-                .take()
-                .map_err(|e| err("motion/imu", e))?
-                .map(|(m, _)| (m.header.stamp, Reading::Imu(Box::new(m)))),
+            Input::Odom(s) => match s.take().map_err(|e| err("motion/odom", e))? {
+                Some((m, _)) => {
+                    keep(rec, m.header.stamp, &m)?;
+                    Some((m.header.stamp, Reading::Pose(m.pose.pose)))
+                }
+                None => None,
+            },
+            Input::Pose(s) => match s.take().map_err(|e| err("motion/pose", e))? {
+                Some((m, _)) => {
+                    keep(rec, m.header.stamp, &m)?;
+                    Some((m.header.stamp, Reading::Pose(m.pose)))
+                }
+                None => None,
+            },
+            Input::Imu(s) => match s.take().map_err(|e| err("motion/imu", e))? {
+                Some((m, _)) => {
+                    keep(rec, m.header.stamp, &m)?;
+                    Some((m.header.stamp, Reading::Imu(Box::new(m))))
+                }
+                None => None,
+            },
         })
     }
 }
@@ -355,6 +375,17 @@ pub fn run(
         params.gravity,
     );
     let mut sim = sph::build(params.clone())?;
+    let in_topic = names.resolve(topic)?;
+    let out_topics = [
+        names.resolve("wrench")?,
+        names.resolve("probes")?,
+        names.resolve("pressures")?,
+    ];
+    let mut recorder = if c.record.path.is_empty() {
+        None
+    } else {
+        Some(Recorder::create(&c.record, &cfg.parameters)?)
+    };
     let counts = sim.counts();
     let full_name = format!(
         "{}/{}",
@@ -456,7 +487,7 @@ pub fn run(
         }
         // 1. Drain the input (and what was fetched while stepping).
         let mut got = false;
-        while let Some(sample) = input.take()? {
+        while let Some(sample) = input.take(recorder.as_mut().map(|r| (r, in_topic.as_str())))? {
             pending.push(sample);
         }
         for (stamp, reading) in pending.drain(..) {
@@ -594,7 +625,9 @@ pub fn run(
                 stepped = true;
                 // Fetch input between steps so that the reader's short history (keep last 5) never
                 // overflows while a long stretch is stepped.
-                while let Some(sample) = input.take()? {
+                while let Some(sample) =
+                    input.take(recorder.as_mut().map(|r| (r, in_topic.as_str())))?
+                {
                     pending.push(sample);
                 }
                 let t = sim.time();
@@ -608,6 +641,12 @@ pub fn run(
                     };
                     let stamp = Time::from_secs_f64(base + o.time);
                     let m = output_messages(&params, &c.frames.tank, stamp, &o);
+                    if let Some(r) = recorder.as_mut() {
+                        let ts = stamp.as_secs_f64();
+                        r.write(&out_topics[0], ts, &m.wrench)?;
+                        r.write(&out_topics[1], ts, &m.probes)?;
+                        r.write(&out_topics[2], ts, &m.pressures)?;
+                    }
                     publish(&pub_wrench, m.wrench, "wrench")?;
                     publish(&pub_probes, m.probes, "probes")?;
                     publish(&pub_press, m.pressures, "pressures")?;
@@ -687,6 +726,10 @@ pub fn run(
         if !got && !stepped {
             std::thread::sleep(Duration::from_millis(1));
         }
+    }
+    // The recording is finished on every way out (errors included; Drop covers early returns).
+    if let Some(mut r) = recorder.take() {
+        r.finish()?;
     }
     if let Some(e) = &error {
         log(

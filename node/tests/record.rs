@@ -1,0 +1,211 @@
+//! Recordings read by third-party tools (Python rosbags and mcap + mcap-ros2-support), with the values the run
+//! wrote to its CSVs; an interrupted run leaves a complete bag; a killed one is made whole by `slosh bag repair`.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn slosh() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_slosh"))
+}
+
+/// What the third-party readers decoded (tests/py/read_bag.py).
+fn read_bag(bag: &Path) -> serde_json::Value {
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/py/read_bag.py");
+    let out = Command::new(common::python())
+        .arg(script)
+        .arg(bag)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "the readers failed on {}: {}",
+        bag.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn csv(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+const ARGS: [&str; 6] = [
+    "--set",
+    "dimension=2",
+    "--set",
+    "particle_spacing=0.02",
+    "--set",
+    "output_rate_hz=20",
+];
+
+#[test]
+fn a_recording_is_read_by_rosbags_and_mcap_with_the_values_written() {
+    let dir = common::tmp("record");
+    let bag = dir.join("bag");
+    let st = slosh()
+        .args(["run", "seed_tank_019", "--out"])
+        .arg(dir.join("out"))
+        .args(["--duration", "0.5"])
+        .args(ARGS)
+        .arg("--set")
+        .arg(format!("record.path={}", bag.display()))
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let v = read_bag(&bag);
+    assert_eq!(v["profile"], "ros2");
+    let params: serde_json::Value = serde_json::from_str(
+        v["metadata"]["slosh_parameters"]["parameters"]
+            .as_str()
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(params["fill_height"], 0.19, "the bag documents its case");
+    let wrench = csv(&dir.join("out/wrench.csv"));
+    let probes = csv(&dir.join("out/probes.csv"));
+    for reader in ["rosbags", "mcap"] {
+        let topics = v[reader].as_object().unwrap();
+        let names: Vec<&String> = topics.keys().collect();
+        assert_eq!(
+            names,
+            ["/motion/odom", "/pressures", "/probes", "/wrench"],
+            "{reader}"
+        );
+        assert_eq!(
+            v[reader]["/wrench"]["type"],
+            "geometry_msgs/msg/WrenchStamped"
+        );
+        assert_eq!(v[reader]["/probes"]["type"], "slosh_msgs/msg/ProbeArray");
+        let w = v[reader]["/wrench"]["items"].as_array().unwrap();
+        let p = v[reader]["/probes"]["items"].as_array().unwrap();
+        assert_eq!(w.len(), wrench.len(), "{reader}: one wrench per CSV row");
+        assert_eq!(p.len(), probes.len());
+        for (item, row) in w.iter().zip(&wrench) {
+            let t = item[0].as_f64().unwrap();
+            assert!(
+                (t - row[0]).abs() < 1e-6,
+                "{reader}: log time {t} vs {}",
+                row[0]
+            );
+            for k in 0..6 {
+                let got = item[1][k].as_f64().unwrap();
+                assert!(
+                    (got - row[k + 1]).abs() <= 1e-6 * (1.0 + row[k + 1].abs()),
+                    "{reader}: {got} vs {}",
+                    row[k + 1]
+                );
+            }
+        }
+        for (item, row) in p.iter().zip(&probes) {
+            for k in 0..2 {
+                let got = item[1][k].as_f64().unwrap();
+                assert!(
+                    (got - row[k + 1]).abs() < 1e-6,
+                    "{reader}: probe {got} vs {}",
+                    row[k + 1]
+                );
+            }
+        }
+    }
+    // A bag is never overwritten: a second run into the same folder stops before it starts.
+    let out = slosh()
+        .args(["run", "seed_tank_019", "--out"])
+        .arg(dir.join("out2"))
+        .args(["--duration", "0.1"])
+        .args(ARGS)
+        .arg("--set")
+        .arg(format!("record.path={}", bag.display()))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("record.path"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Starts a long run that records with small chunks, waits until a few chunks are on disk, then sends `signal`.
+fn interrupted_run(dir: &Path, signal: &str) -> std::process::ExitStatus {
+    let bag = dir.join("bag");
+    let mut child = slosh()
+        .args(["run", "seed_tank_019", "--out"])
+        .arg(dir.join("out"))
+        .args(["--duration", "60"])
+        .args(ARGS)
+        .args(["--set", "record.chunk_size=4096", "--set"])
+        .arg(format!("record.path={}", bag.display()))
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let file = bag.join("bag_0.mcap");
+    let start = Instant::now();
+    while std::fs::metadata(&file).map(|m| m.len()).unwrap_or(0) < 20_000 {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the recording does not grow"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let pid = child.id().to_string();
+    assert!(Command::new("kill")
+        .args([signal, &pid])
+        .status()
+        .unwrap()
+        .success());
+    child.wait().unwrap()
+}
+
+#[test]
+fn sigint_leaves_a_complete_bag() {
+    let dir = common::tmp("record-sigint");
+    let status = interrupted_run(&dir, "-INT");
+    assert!(!status.success(), "an interrupted run reports it");
+    assert!(dir.join("bag/metadata.yaml").exists());
+    let v = read_bag(&dir.join("bag"));
+    let n = v["rosbags"]["/wrench"]["items"].as_array().unwrap().len();
+    assert!(n > 5, "{n} wrench messages");
+    assert_eq!(n, v["mcap"]["/wrench"]["items"].as_array().unwrap().len());
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert!(summary["error"].as_str().unwrap().contains("interrupted"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn sigkill_then_repair_recovers_the_complete_chunks() {
+    let dir = common::tmp("record-sigkill");
+    let status = interrupted_run(&dir, "-KILL");
+    assert!(!status.success());
+    assert!(
+        !dir.join("bag/metadata.yaml").exists(),
+        "a killed recorder cannot finish"
+    );
+    let out = slosh()
+        .args(["bag", "repair"])
+        .arg(dir.join("bag"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("recovered"), "{said}");
+    let v = read_bag(&dir.join("bag_repaired"));
+    let w = v["rosbags"]["/wrench"]["items"].as_array().unwrap();
+    assert!(w.len() > 5, "{} wrench messages recovered", w.len());
+    // The recovered messages are the run's, in order, on its output grid.
+    for (k, item) in w.iter().enumerate() {
+        let t = item[0].as_f64().unwrap();
+        assert!((t - k as f64 / 20.0).abs() < 0.01, "message {k} at {t}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
