@@ -11,23 +11,6 @@ fn slosh() -> Command {
     Command::new(env!("CARGO_BIN_EXE_slosh"))
 }
 
-/// What the third-party readers decoded (tests/py/read_bag.py).
-fn read_bag(bag: &Path) -> serde_json::Value {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/py/read_bag.py");
-    let out = Command::new(common::python())
-        .arg(script)
-        .arg(bag)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "the readers failed on {}: {}",
-        bag.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
 fn csv(path: &Path) -> Vec<Vec<f64>> {
     std::fs::read_to_string(path)
         .unwrap()
@@ -60,7 +43,7 @@ fn a_recording_is_read_by_rosbags_and_mcap_with_the_values_written() {
         .status()
         .unwrap();
     assert!(st.success());
-    let v = read_bag(&bag);
+    let v = common::read_bag(&bag);
     assert_eq!(v["profile"], "ros2");
     let params: serde_json::Value = serde_json::from_str(
         v["metadata"]["slosh_parameters"]["parameters"]
@@ -167,7 +150,7 @@ fn sigint_leaves_a_complete_bag() {
     let status = interrupted_run(&dir, "-INT");
     assert!(!status.success(), "an interrupted run reports it");
     assert!(dir.join("bag/metadata.yaml").exists());
-    let v = read_bag(&dir.join("bag"));
+    let v = common::read_bag(&dir.join("bag"));
     let n = v["rosbags"]["/wrench"]["items"].as_array().unwrap().len();
     assert!(n > 5, "{n} wrench messages");
     assert_eq!(n, v["mcap"]["/wrench"]["items"].as_array().unwrap().len());
@@ -199,7 +182,7 @@ fn sigkill_then_repair_recovers_the_complete_chunks() {
     );
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(said.contains("recovered"), "{said}");
-    let v = read_bag(&dir.join("bag_repaired"));
+    let v = common::read_bag(&dir.join("bag_repaired"));
     let w = v["rosbags"]["/wrench"]["items"].as_array().unwrap();
     assert!(w.len() > 5, "{} wrench messages recovered", w.len());
     // The recovered messages are the run's, in order, on its output grid.

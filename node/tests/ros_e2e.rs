@@ -42,6 +42,18 @@ impl Drop for Kill {
     }
 }
 
+/// A DDS context on `domain` and a node of this test in it (keep the context alive with the node).
+fn test_node(domain: u16, name: &str) -> (Context, ros2_client::Node) {
+    let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
+    let node = ctx
+        .new_node(
+            NodeName::new("/", name).unwrap(),
+            NodeOptions::new().enable_rosout(false),
+        )
+        .unwrap();
+    (ctx, node)
+}
+
 fn sub<M: RosMessage + 'static>(
     node: &mut ros2_client::Node,
     ns: &str,
@@ -100,13 +112,7 @@ fn compare_with_run(kind: &str, domain_id: u16) {
     let domain = domain.as_str();
 
     // The subscriber first, so it sees every output.
-    let ctx = Context::with_options(ContextOptions::new().domain_id(domain_id)).unwrap();
-    let mut node = ctx
-        .new_node(
-            NodeName::new("/", "e2e_listener").unwrap(),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .unwrap();
+    let (_ctx, mut node) = test_node(domain_id, "e2e_listener");
     let wrench = sub::<WrenchStamped>(&mut node, "/ship1", "wrench");
     let probes = sub::<ProbeArray>(&mut node, "/ship1", "probes");
     let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
@@ -284,18 +290,7 @@ fn compare_with_run(kind: &str, domain_id: u16) {
     );
 
     // The node's recording holds the motion as received and the outputs as published (third-party readers).
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/py/read_bag.py");
-    let out = Command::new(common::python())
-        .arg(script)
-        .arg(dir.join("bag"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let bag: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let bag = common::read_bag(&dir.join("bag"));
     let motion_topic = if kind == "imu" {
         "/ship1/motion/imu"
     } else {
@@ -411,16 +406,8 @@ fn pause_and_reset_services() {
     if !common::in_private_netns("pause_and_reset_services") {
         return;
     }
-    let dir = common::tmp("ros-services");
-    let case = dir.join("case.yaml");
-    std::fs::write(&case, common::small_case("")).unwrap();
-    let ctx = Context::with_options(ContextOptions::new().domain_id(31)).unwrap();
-    let mut node = ctx
-        .new_node(
-            NodeName::new("/", "e2e_services").unwrap(),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .unwrap();
+    let (dir, case) = common::case_dir("ros-services", "");
+    let (_ctx, mut node) = test_node(31, "e2e_services");
     let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
@@ -526,16 +513,8 @@ fn follow_clock_never_runs_ahead_of_ros_time() {
     if !common::in_private_netns("follow_clock_never_runs_ahead_of_ros_time") {
         return;
     }
-    let dir = common::tmp("ros-clock");
-    let case = dir.join("case.yaml");
-    std::fs::write(&case, common::small_case("")).unwrap();
-    let ctx = Context::with_options(ContextOptions::new().domain_id(37)).unwrap();
-    let mut node = ctx
-        .new_node(
-            NodeName::new("/", "e2e_clock").unwrap(),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .unwrap();
+    let (dir, case) = common::case_dir("ros-clock", "");
+    let (_ctx, mut node) = test_node(37, "e2e_clock");
     let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
@@ -601,9 +580,7 @@ fn ros_domain_id_takes_effect() {
     if !common::in_private_netns("ros_domain_id_takes_effect") {
         return;
     }
-    let dir = common::tmp("ros-domain");
-    let case = dir.join("case.yaml");
-    std::fs::write(&case, common::small_case("    diagnostics_rate_hz: 5.0\n")).unwrap();
+    let (dir, case) = common::case_dir("ros-domain", "    diagnostics_rate_hz: 5.0\n");
     let listen = |domain: u16| {
         let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
         let mut node = ctx
@@ -665,13 +642,7 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
         common::small_case("    motion_timeout_s: 0.5\n    diagnostics_rate_hz: 10.0\n"),
     )
     .unwrap();
-    let ctx = Context::with_options(ContextOptions::new().domain_id(43)).unwrap();
-    let mut node = ctx
-        .new_node(
-            NodeName::new("/", "e2e_timeout").unwrap(),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .unwrap();
+    let (_ctx, mut node) = test_node(43, "e2e_timeout");
     let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
     let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });

@@ -11,15 +11,10 @@ fn cyclonedds_peer_drives_the_node_and_reads_its_outputs() {
     if !common::in_private_netns("cyclonedds_peer_drives_the_node_and_reads_its_outputs") {
         return;
     }
-    let dir = common::tmp("ros-peer");
-    let case = dir.join("case.yaml");
-    std::fs::write(
-        &case,
-        common::small_case(
-            "    pressure_sensors: {names: [bottom], x: [0.0], y: [0.0], z: [0.0]}\n",
-        ),
-    )
-    .unwrap();
+    let (dir, case) = common::case_dir(
+        "ros-peer",
+        "    pressure_sensors: {names: [bottom], x: [0.0], y: [0.0], z: [0.0]}\n",
+    );
     let domain = "23";
     let mut node = Command::new(env!("CARGO_BIN_EXE_slosh"))
         .args(["node", "--duration", "2.0", "--ros-args", "--params-file"])

@@ -87,3 +87,28 @@ pub fn small_case(extra: &str) -> String {
 {extra}"
     )
 }
+
+/// A fresh folder for one test with `case.yaml` holding [`small_case`]`(extra)`: (folder, case file).
+pub fn case_dir(name: &str, extra: &str) -> (PathBuf, PathBuf) {
+    let dir = tmp(name);
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, small_case(extra)).unwrap();
+    (dir, case)
+}
+
+/// What the third-party bag readers decoded (tests/py/read_bag.py: rosbags and mcap + mcap-ros2-support).
+pub fn read_bag(bag: &std::path::Path) -> serde_json::Value {
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/py/read_bag.py");
+    let out = Command::new(python())
+        .arg(script)
+        .arg(bag)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "the readers failed on {}: {}",
+        bag.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
