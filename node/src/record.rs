@@ -43,6 +43,14 @@ pub enum RecordError {
     Write { path: String, message: String },
 }
 
+/// A failure while writing the bag in `dir`.
+fn write_error(dir: &Path, e: impl std::fmt::Display) -> RecordError {
+    RecordError::Write {
+        path: dir.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
 /// The QoS string written both in the channels' metadata and in `metadata.yaml` (they must be identical for
 /// rosbags to read the messages); empty means the reader's defaults.
 const OFFERED_QOS: &str = "";
@@ -122,10 +130,7 @@ impl Recorder {
     }
 
     fn write_err(&self, e: impl std::fmt::Display) -> RecordError {
-        RecordError::Write {
-            path: self.dir.display().to_string(),
-            message: e.to_string(),
-        }
+        write_error(&self.dir, e)
     }
 
     /// Records `msg` on `topic` at `log_time` seconds (ROS time, ≥ 0).
@@ -151,16 +156,11 @@ impl Recorder {
         log_time_ns: u64,
         data: &[u8],
     ) -> Result<(), RecordError> {
-        let dir = self.dir.display().to_string();
-        let err = |e: mcap::McapError| RecordError::Write {
-            path: dir.clone(),
-            message: e.to_string(),
-        };
+        // A free function: `writer` below borrows `self` mutably.
+        let dir = &self.dir;
+        let err = |e: mcap::McapError| write_error(dir, e);
         let Some(writer) = self.writer.as_mut() else {
-            return Err(RecordError::Write {
-                path: dir.clone(),
-                message: "the recording is already finished".into(),
-            });
+            return Err(write_error(dir, "the recording is already finished"));
         };
         let id = match self.channels.get(topic) {
             Some(c) => c.id,
@@ -198,6 +198,18 @@ impl Recorder {
         self.start_ns = Some(self.start_ns.map_or(log_time_ns, |s| s.min(log_time_ns)));
         self.end_ns = self.end_ns.max(log_time_ns);
         Ok(())
+    }
+
+    /// Records the outputs of one state on `topics` (wrench, probes, pressures) at `log_time` seconds.
+    pub fn write_outputs(
+        &mut self,
+        topics: &[String; 3],
+        log_time: f64,
+        m: &crate::ros::node::OutputMessages,
+    ) -> Result<(), RecordError> {
+        self.write(&topics[0], log_time, &m.wrench)?;
+        self.write(&topics[1], log_time, &m.probes)?;
+        self.write(&topics[2], log_time, &m.pressures)
     }
 
     /// The folder of the bag.
@@ -261,11 +273,10 @@ pub fn record_state(
 ) -> Result<(), RecordError> {
     let stamp = slosh_msgs::builtin_interfaces::Time::from_secs_f64(o.time);
     let m = crate::ros::node::output_messages(params, tank_frame, stamp, o);
-    let odom = crate::ros::motion_pub::odometry(motion, o.time, stamp, "world", tank_frame);
+    let odom = crate::ros::motion_pub::odometry(&motion.state(o.time), stamp, "world", tank_frame);
     rec.write("/motion/odom", o.time, &odom)?;
-    rec.write("/wrench", o.time, &m.wrench)?;
-    rec.write("/probes", o.time, &m.probes)?;
-    rec.write("/pressures", o.time, &m.pressures)
+    let topics = ["/wrench", "/probes", "/pressures"].map(String::from);
+    rec.write_outputs(&topics, o.time, &m)
 }
 
 /// What [`repair`] recovered.

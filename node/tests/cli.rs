@@ -1,26 +1,14 @@
 //! End to end: the `slosh` binary as a user runs it.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-fn slosh() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_slosh"))
-}
+use common::{csv, slosh};
+use std::path::PathBuf;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("slosh-test-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
-}
-
-fn csv(path: &PathBuf) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
-    (header, rows)
 }
 
 #[test]

@@ -3,22 +3,11 @@
 
 mod common;
 
+use common::slosh;
+
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-fn slosh() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_slosh"))
-}
-
-fn csv(path: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect()
-}
 
 const ARGS: [&str; 6] = [
     "--set",
@@ -52,8 +41,8 @@ fn a_recording_is_read_by_rosbags_and_mcap_with_the_values_written() {
     )
     .unwrap();
     assert_eq!(params["fill_height"], 0.19, "the bag documents its case");
-    let wrench = csv(&dir.join("out/wrench.csv"));
-    let probes = csv(&dir.join("out/probes.csv"));
+    let wrench = common::csv(&dir.join("out/wrench.csv")).1;
+    let probes = common::csv(&dir.join("out/probes.csv")).1;
     for reader in ["rosbags", "mcap"] {
         let topics = v[reader].as_object().unwrap();
         let names: Vec<&String> = topics.keys().collect();

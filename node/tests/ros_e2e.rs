@@ -3,6 +3,8 @@
 
 mod common;
 
+use common::slosh;
+
 use ros2_client::qos::{History, WhenFull};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
@@ -29,10 +31,6 @@ const EXTRA: &str = "    pressure_sensors: {names: [wall], x: [-0.4], y: [0.0], 
 /// Start of the motion's stamps (s since the epoch) so that output stamps map back to simulation time.
 const T0: f64 = 1000.0;
 const DURATION: f64 = 3.0;
-
-fn slosh() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_slosh"))
-}
 
 struct Kill(Child);
 impl Drop for Kill {
@@ -73,15 +71,6 @@ fn sub<M: RosMessage + 'static>(
 }
 
 /// (time, values) rows of a CSV written by `slosh run`.
-fn csv(path: &std::path::Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect()
-}
-
 #[test]
 fn motion_to_node_to_subscriber_matches_slosh_run() {
     if common::in_private_netns("motion_to_node_to_subscriber_matches_slosh_run") {
@@ -231,8 +220,8 @@ fn compare_with_run(kind: &str, domain_id: u16) {
         .status()
         .unwrap();
     assert!(st.success());
-    let run_w = csv(&out.join("wrench.csv"));
-    let run_p = csv(&out.join("probes.csv"));
+    let run_w = common::csv(&out.join("wrench.csv")).1;
+    let run_p = common::csv(&out.join("probes.csv")).1;
 
     let expected = (DURATION * 20.0) as usize;
     assert!(

@@ -16,7 +16,7 @@ fn cyclonedds_peer_drives_the_node_and_reads_its_outputs() {
         "    pressure_sensors: {names: [bottom], x: [0.0], y: [0.0], z: [0.0]}\n",
     );
     let domain = "23";
-    let mut node = Command::new(env!("CARGO_BIN_EXE_slosh"))
+    let mut node = common::slosh()
         .args(["node", "--duration", "2.0", "--ros-args", "--params-file"])
         .arg(&case)
         .args(["-r", "__ns:=/peer", "-p", "realtime.mode:=lockstep"])

@@ -2,11 +2,12 @@
 //! spline, or IMU readings. Converts from the configured frame conventions and gives the solver a
 //! [`TankMotion`] that never extends past what was received.
 
+use super::convert::{position, unit, vector};
 use super::frames::Frames;
 use super::live_imu::{ImuSample, LiveImu};
 use super::live_motion::{Limits, LiveMotion, Rejected};
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use slosh_msgs::geometry_msgs::{Pose, Quaternion as QuatMsg, Vector3 as Vec3Msg};
+use nalgebra::{UnitQuaternion, Vector3};
+use slosh_msgs::geometry_msgs::{Pose, Vector3 as Vec3Msg};
 use slosh_msgs::sensor_msgs::Imu;
 use sph::motion::{RigidState, TankMotion};
 
@@ -60,16 +61,6 @@ impl Accel {
     }
 }
 
-fn unit(q: &QuatMsg) -> UnitQuaternion<f64> {
-    let q = Quaternion::new(q.w, q.x, q.y, q.z);
-    // A zero quaternion (orientation unset) normalises to NaN, which the sample checks reject by name.
-    UnitQuaternion::new_unchecked(q / q.norm())
-}
-
-fn vector(v: &Vec3Msg) -> Vector3<f64> {
-    Vector3::new(v.x, v.y, v.z)
-}
-
 impl Live {
     /// Empty input of the kind `imu` says, for a tank mounted as `frames` says.
     pub fn new(imu: bool, limits: Limits, frames: &Frames, gravity: f64) -> Self {
@@ -121,10 +112,10 @@ impl Live {
     /// Adds a sample at time `t`, converted by `frames`.
     pub fn push(&mut self, t: f64, r: &Reading, frames: &Frames) -> Result<(), Rejected> {
         match (self, r) {
-            (Live::Pose(m, _), Reading::Pose(p)) => {
-                let position = Vector3::new(p.position.x, p.position.y, p.position.z);
-                m.push(t, frames.tank_coordinates(position, unit(&p.orientation)))
-            }
+            (Live::Pose(m, _), Reading::Pose(p)) => m.push(
+                t,
+                frames.tank_coordinates(position(&p.position), unit(&p.orientation)),
+            ),
             (Live::Imu(m), Reading::Imu(i)) => m.push(
                 t,
                 ImuSample {
@@ -189,6 +180,7 @@ impl TankMotion for Live {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ros::convert::{point_msg, quat_msg, vec3_msg};
     use crate::ros::frames::{BodyFrame, TankPose, WorldFrame};
     use sph::motion::{Dof6Motion, RegularDof, RegularMotion};
 
@@ -223,34 +215,24 @@ mod tests {
         };
         let mut live = Live::new(false, limits, &frames, 9.81);
         // Poses only at 5 Hz (a coarse spline); accelerations at 50 Hz.
-        let v3 = |v: Vector3<f64>| Vec3Msg {
-            x: v.x,
-            y: v.y,
-            z: v.z,
-        };
         for k in 0..=100 {
             let t = k as f64 * 0.02;
             let s = m.dof(t).to_state();
             if k % 10 == 0 {
-                let q = s.orientation;
                 let pose = Pose {
-                    position: slosh_msgs::geometry_msgs::Point {
-                        x: s.position.x,
-                        y: s.position.y,
-                        z: s.position.z,
-                    },
-                    orientation: QuatMsg {
-                        x: q.i,
-                        y: q.j,
-                        z: q.k,
-                        w: q.w,
-                    },
+                    position: point_msg(s.position),
+                    orientation: quat_msg(s.orientation),
                 };
                 live.push(t, &Reading::Pose(pose), &frames).unwrap();
             }
             let a_body = s.orientation.inverse_transform_vector(&s.acceleration);
-            live.push_accel(t, &v3(a_body), &v3(s.angular_acceleration), &frames)
-                .unwrap();
+            live.push_accel(
+                t,
+                &vec3_msg(a_body),
+                &vec3_msg(s.angular_acceleration),
+                &frames,
+            )
+            .unwrap();
         }
         let t = 1.01;
         let s = m.dof(t).to_state();

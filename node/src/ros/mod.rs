@@ -3,6 +3,7 @@
 
 pub mod args;
 pub mod cloud;
+pub mod convert;
 pub mod frames;
 pub mod live;
 pub mod live_imu;
@@ -76,6 +77,19 @@ pub fn subscription<M: RosMessage + 'static>(
     let topic = topic::<M>(node, names, name, qos)?;
     node.create_subscription::<M>(&topic, Some(qos.clone()))
         .map_err(|e| anyhow::anyhow!("subscription to `{name}`: {e:?}"))
+}
+
+/// Publishes `m`. A slow reliable reader must not stop the simulation or the motion: when its window is
+/// full the sample is dropped for it (`WouldBlock`); other failures are errors naming `what`.
+pub fn publish<M: serde::Serialize + std::fmt::Debug>(
+    p: &ros2_client::Publisher<M>,
+    m: M,
+    what: &str,
+) -> anyhow::Result<()> {
+    match p.publish(m) {
+        Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => Ok(()),
+        Err(e) => Err(anyhow::anyhow!("publishing {what}: {e:?}")),
+    }
 }
 
 /// SIGINT and SIGTERM set the returned flag, so loops can end cleanly (and files get finished).

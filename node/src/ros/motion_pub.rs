@@ -3,19 +3,20 @@
 //! for headless CI and demos. Paced by the wall clock, or in lockstep with a simulation's `/clock`.
 
 use super::args::{Names, RosArgs};
+use super::convert::{point_msg, quat_msg, vec3_msg};
+use super::publish;
 use crate::motion_source;
-use nalgebra::UnitQuaternion;
 use ros2_client::qos::{History, WhenFull};
 use ros2_client::{NodeName, NodeOptions, QosProfile};
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::geometry_msgs::{
-    Accel, AccelStamped, Point, Pose, PoseStamped, PoseWithCovariance, Quaternion, Twist,
-    TwistWithCovariance, Vector3,
+    Accel, AccelStamped, Pose, PoseStamped, PoseWithCovariance, Twist, TwistWithCovariance,
 };
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
 use slosh_msgs::sensor_msgs::Imu;
 use slosh_msgs::std_msgs::Header;
+use sph::motion::RigidState;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
@@ -40,17 +41,9 @@ pub struct MotionOptions {
     pub start_stamp: Option<f64>,
 }
 
-/// The Odometry of the motion at time t (pose in the world, twist in the body frame as REP 105 says).
-pub fn odometry(
-    motion: &dyn sph::motion::TankMotion,
-    t: f64,
-    stamp: Time,
-    world: &str,
-    body: &str,
-) -> Odometry {
-    let s = motion.state(t);
-    let q: UnitQuaternion<f64> = s.orientation;
-    let v_body = q.inverse_transform_vector(&s.velocity);
+/// The Odometry of a rigid state (pose in the world, twist in the body frame as REP 105 says).
+pub fn odometry(s: &RigidState, stamp: Time, world: &str, body: &str) -> Odometry {
+    let v_body = s.orientation.inverse_transform_vector(&s.velocity);
     Odometry {
         header: Header {
             stamp,
@@ -59,71 +52,51 @@ pub fn odometry(
         child_frame_id: body.into(),
         pose: PoseWithCovariance {
             pose: Pose {
-                position: Point {
-                    x: s.position.x,
-                    y: s.position.y,
-                    z: s.position.z,
-                },
-                orientation: Quaternion {
-                    x: q.i,
-                    y: q.j,
-                    z: q.k,
-                    w: q.w,
-                },
+                position: point_msg(s.position),
+                orientation: quat_msg(s.orientation),
             },
             covariance: [0.0; 36],
         },
         twist: TwistWithCovariance {
             twist: Twist {
-                linear: Vector3 {
-                    x: v_body.x,
-                    y: v_body.y,
-                    z: v_body.z,
-                },
-                angular: Vector3 {
-                    x: s.angular_velocity.x,
-                    y: s.angular_velocity.y,
-                    z: s.angular_velocity.z,
-                },
+                linear: vec3_msg(v_body),
+                angular: vec3_msg(s.angular_velocity),
             },
             covariance: [0.0; 36],
         },
     }
 }
 
-/// What an IMU at the vessel's origin reads at time t: orientation, body angular velocity, and specific force
+/// The accelerations of a rigid state in its body frame, as geometry_msgs/AccelStamped.
+pub fn accel(s: &RigidState, stamp: Time, body: &str) -> AccelStamped {
+    AccelStamped {
+        header: Header {
+            stamp,
+            frame_id: body.into(),
+        },
+        accel: Accel {
+            linear: vec3_msg(s.orientation.inverse_transform_vector(&s.acceleration)),
+            angular: vec3_msg(s.angular_acceleration),
+        },
+    }
+}
+
+/// What an IMU at the origin of a rigid state reads: orientation, body angular velocity, and specific force
 /// (acceleration minus gravity, in the body frame).
-pub fn imu(
-    motion: &dyn sph::motion::TankMotion,
-    t: f64,
-    stamp: Time,
-    body: &str,
-    gravity: f64,
-) -> Imu {
-    let s = motion.state(t);
+pub fn imu(s: &RigidState, stamp: Time, body: &str, gravity: f64) -> Imu {
     let q = s.orientation;
     let f =
         q.inverse_transform_vector(&(s.acceleration - nalgebra::Vector3::new(0.0, 0.0, -gravity)));
-    let v = |v: nalgebra::Vector3<f64>| Vector3 {
-        x: v.x,
-        y: v.y,
-        z: v.z,
-    };
     Imu {
         header: Header {
             stamp,
             frame_id: body.into(),
         },
-        orientation: Quaternion {
-            x: q.i,
-            y: q.j,
-            z: q.k,
-            w: q.w,
-        },
+        orientation: quat_msg(q),
         orientation_covariance: [0.0; 9],
-        angular_velocity: v(s.angular_velocity),
+        angular_velocity: vec3_msg(s.angular_velocity),
         angular_velocity_covariance: [0.0; 9],
-        linear_acceleration: v(f),
+        linear_acceleration: vec3_msg(f),
         linear_acceleration_covariance: [0.0; 9],
     }
 }
@@ -268,49 +241,23 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
             break;
         }
         let stamp = Time::from_secs_f64(start_stamp + t);
-        let odom = odometry(motion.as_ref(), t, stamp, "odom", "base_link");
+        let state = motion.state(t);
+        let odom = odometry(&state, stamp, "odom", "base_link");
         if let Some(p) = &pub_accel {
-            let st = motion.state(t);
-            let a = st.orientation.inverse_transform_vector(&st.acceleration);
-            let v = |v: nalgebra::Vector3<f64>| Vector3 {
-                x: v.x,
-                y: v.y,
-                z: v.z,
-            };
-            let m = AccelStamped {
-                header: Header {
-                    stamp,
-                    frame_id: "base_link".into(),
-                },
-                accel: Accel {
-                    linear: v(a),
-                    angular: v(st.angular_acceleration),
-                },
-            };
-            match p.publish(m) {
-                Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => {}
-                Err(e) => anyhow::bail!("publishing motion/accel: {e:?}"),
-            }
+            publish(p, accel(&state, stamp, "base_link"), "motion/accel")?;
         }
         if let Some(p) = &pub_imu {
-            let m = imu(motion.as_ref(), t, stamp, "base_link", cfg.config.gravity);
-            match p.publish(m) {
-                Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => {}
-                Err(e) => anyhow::bail!("publishing motion/imu: {e:?}"),
-            }
+            let m = imu(&state, stamp, "base_link", cfg.config.gravity);
+            publish(p, m, "motion/imu")?;
         }
         if let Some(p) = &pub_pose {
             let ps = PoseStamped {
                 header: odom.header.clone(),
                 pose: odom.pose.pose,
             };
-            p.publish(ps)
-                .map_err(|e| anyhow::anyhow!("publishing motion/pose: {e:?}"))?;
+            publish(p, ps, "motion/pose")?;
         }
-        match pub_odom.publish(odom) {
-            Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => {}
-            Err(e) => anyhow::bail!("publishing motion/odom: {e:?}"),
-        }
+        publish(&pub_odom, odom, "motion/odom")?;
     }
     // Let reliable readers fetch the last samples.
     std::thread::sleep(Duration::from_millis(300));

@@ -3,10 +3,12 @@
 //! describe (the input's time base: output stamp = first input stamp + simulation time).
 
 use super::args::{Names, RosArgs};
+use super::convert::{quat_msg, vec3_msg};
 use super::frames::Frames;
 use super::live::{Live, Reading};
 use super::live_motion::Limits;
 use super::pacing::Pacing;
+use super::publish;
 use crate::config::{InputType, Loaded, RealtimeMode, StampSource};
 use crate::record::Recorder;
 use nalgebra::UnitQuaternion;
@@ -15,8 +17,7 @@ use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile, ServiceMapping, 
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
 use slosh_msgs::geometry_msgs::{
-    AccelStamped, Point, PoseStamped, Quaternion as QuatMsg, Transform, TransformStamped,
-    Vector3 as Vec3Msg, Wrench, WrenchStamped,
+    AccelStamped, Point, PoseStamped, Transform, TransformStamped, Wrench, WrenchStamped,
 };
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
@@ -98,22 +99,12 @@ pub fn output_messages(
     stamp: Time,
     o: &sph::observe::Observation,
 ) -> OutputMessages {
-    let [fx, fy, fz] = o.wrench.force;
-    let [mx, my, mz] = o.wrench.moment;
     OutputMessages {
         wrench: WrenchStamped {
             header: header(stamp, tank_frame),
             wrench: Wrench {
-                force: Vec3Msg {
-                    x: fx,
-                    y: fy,
-                    z: fz,
-                },
-                torque: Vec3Msg {
-                    x: mx,
-                    y: my,
-                    z: mz,
-                },
+                force: vec3_msg(o.wrench.force.into()),
+                torque: vec3_msg(o.wrench.moment.into()),
             },
         },
         probes: ProbeArray {
@@ -148,17 +139,8 @@ fn static_transforms(cfg: &Loaded, params: &SimParams, stamp: Time) -> TFMessage
         header: header(stamp, parent),
         child_frame_id: child,
         transform: Transform {
-            translation: Vec3Msg {
-                x: t[0],
-                y: t[1],
-                z: t[2],
-            },
-            rotation: QuatMsg {
-                x: q.i,
-                y: q.j,
-                z: q.k,
-                w: q.w,
-            },
+            translation: vec3_msg(t.into()),
+            rotation: quat_msg(q),
         },
     };
     let mut transforms = vec![tf(&f.vessel, f.tank.clone(), [tp.x, tp.y, tp.z], q)];
@@ -277,18 +259,12 @@ pub fn run(
     let topic = Input::topic(c.input.kind);
     let input = match c.input.kind {
         InputType::Imu => Input::Imu(super::subscription(&mut node, &names, topic, &qos_input())?),
-        InputType::Odom => Input::Odom(super::subscription(
-            &mut node,
-            &names,
-            "motion/odom",
-            &qos_input(),
-        )?),
-        InputType::Pose => Input::Pose(super::subscription(
-            &mut node,
-            &names,
-            "motion/pose",
-            &qos_input(),
-        )?),
+        InputType::Odom => {
+            Input::Odom(super::subscription(&mut node, &names, topic, &qos_input())?)
+        }
+        InputType::Pose => {
+            Input::Pose(super::subscription(&mut node, &names, topic, &qos_input())?)
+        }
     };
     let sub_accel: Option<ros2_client::Subscription<AccelStamped>> =
         if c.input.accel && c.input.kind != InputType::Imu {
@@ -365,15 +341,11 @@ pub fn run(
 
     let frames = Frames::new(c.input.world_frame, c.input.body_frame, c.frames.tank_pose);
     let imu = c.input.kind == InputType::Imu;
-    let mut motion = Live::new(
-        imu,
-        Limits {
-            max_speed: c.input.max_speed,
-            max_rotation_rate: c.input.max_rotation_rate,
-        },
-        &frames,
-        params.gravity,
-    );
+    let limits = Limits {
+        max_speed: c.input.max_speed,
+        max_rotation_rate: c.input.max_rotation_rate,
+    };
+    let mut motion = Live::new(imu, limits, &frames, params.gravity);
     let mut sim = sph::build(params.clone())?;
     let in_topic = names.resolve(topic)?;
     let out_topics = [
@@ -412,7 +384,7 @@ pub fn run(
             counts.fluid,
             counts.boundary,
             c.realtime.mode,
-            names.resolve(topic)?
+            in_topic
         ),
     );
 
@@ -434,10 +406,6 @@ pub fn run(
     let mut paused = false;
     // After a reset or a resume the next sample is placed at the current simulation time.
     let mut rebase = false;
-    let limits = Limits {
-        max_speed: c.input.max_speed,
-        max_rotation_rate: c.input.max_rotation_rate,
-    };
 
     while !stop.load(Ordering::Relaxed) {
         // 0. Services: ~/reset starts the liquid again at rest, ~/pause freezes the simulation.
@@ -642,10 +610,7 @@ pub fn run(
                     let stamp = Time::from_secs_f64(base + o.time);
                     let m = output_messages(&params, &c.frames.tank, stamp, &o);
                     if let Some(r) = recorder.as_mut() {
-                        let ts = stamp.as_secs_f64();
-                        r.write(&out_topics[0], ts, &m.wrench)?;
-                        r.write(&out_topics[1], ts, &m.probes)?;
-                        r.write(&out_topics[2], ts, &m.pressures)?;
+                        r.write_outputs(&out_topics, stamp.as_secs_f64(), &m)?;
                     }
                     publish(&pub_wrench, m.wrench, "wrench")?;
                     publish(&pub_probes, m.probes, "probes")?;
@@ -762,19 +727,6 @@ pub fn run(
     // Give reliable readers a moment to acknowledge the last messages before the participant goes away.
     std::thread::sleep(Duration::from_millis(300));
     Ok(())
-}
-
-fn publish<M: serde::Serialize + std::fmt::Debug>(
-    p: &Publisher<M>,
-    m: M,
-    what: &str,
-) -> anyhow::Result<()> {
-    match p.publish(m) {
-        Ok(()) => Ok(()),
-        // A slow reliable reader must not stop the simulation: the sample is dropped for it.
-        Err(ros2_client::WriteError::WouldBlock { .. }) => Ok(()),
-        Err(e) => Err(anyhow::anyhow!("publishing {what}: {e:?}")),
-    }
 }
 
 fn maybe_diagnostics(

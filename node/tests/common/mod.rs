@@ -112,3 +112,19 @@ pub fn read_bag(bag: &std::path::Path) -> serde_json::Value {
     );
     serde_json::from_slice(&out.stdout).unwrap()
 }
+
+/// The `slosh` binary under test.
+pub fn slosh() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_slosh"))
+}
+
+/// A CSV written by `slosh run`: (header, rows of numbers).
+pub fn csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
