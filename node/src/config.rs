@@ -194,6 +194,9 @@ pub struct RunConfig {
     /// Recording to a rosbag2 MCAP folder (`record.path`; empty: off).
     #[serde(default)]
     pub record: crate::record::RecordCfg,
+    /// How `slosh replay` treats bad samples in a bag.
+    #[serde(default)]
+    pub replay: crate::replay::ReplayCfg,
     /// The `particles` PointCloud2 output of `slosh node` (off by default).
     #[serde(default)]
     pub particles: ParticlesCfg,

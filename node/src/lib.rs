@@ -9,5 +9,6 @@ pub mod config;
 pub mod motion_source;
 pub mod output;
 pub mod record;
+pub mod replay;
 pub mod ros;
 pub mod runner;

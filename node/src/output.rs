@@ -104,6 +104,9 @@ pub struct Summary {
     pub liquid_mass_kg: f64,
     /// Why the run stopped early, if it did.
     pub error: Option<String>,
+    /// Where the motion came from, for runs not driven by the config's `motion.*` (e.g. `slosh replay`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input: Option<serde_json::Value>,
     pub parameters: serde_json::Value,
 }
 

@@ -5,6 +5,7 @@
 //! [`Recorder::finish`] writes the summary and `metadata.yaml`; dropping an unfinished recorder finishes it, so
 //! a run that stops on an error still leaves a readable bag.
 
+use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::RosMessage;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -44,6 +45,17 @@ pub enum RecordError {
 }
 
 /// A failure while writing the bag in `dir`.
+/// An error with its causes (the MCAP writer's own message hides the I/O error under it, e.g. a full disk).
+fn with_causes(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        s += &format!(": {c}");
+        cause = c.source();
+    }
+    s
+}
+
 fn write_error(dir: &Path, e: impl std::fmt::Display) -> RecordError {
     RecordError::Write {
         path: dir.display().to_string(),
@@ -109,7 +121,7 @@ impl Recorder {
             .compression(compression)
             .chunk_size(Some(cfg.chunk_size.max(4096)))
             .create(BufWriter::new(file))
-            .map_err(|e| err(format!("cannot start the MCAP file: {e}")))?;
+            .map_err(|e| err(format!("cannot start the MCAP file: {}", with_causes(&e))))?;
         let mut meta = BTreeMap::new();
         meta.insert("parameters".to_string(), parameters.to_string());
         writer
@@ -117,7 +129,7 @@ impl Recorder {
                 name: "slosh_parameters".into(),
                 metadata: meta,
             })
-            .map_err(|e| err(format!("cannot write the parameters: {e}")))?;
+            .map_err(|e| err(format!("cannot write the parameters: {}", with_causes(&e))))?;
         Ok(Self {
             dir,
             file_name,
@@ -133,14 +145,14 @@ impl Recorder {
         write_error(&self.dir, e)
     }
 
-    /// Records `msg` on `topic` at `log_time` seconds (ROS time, ≥ 0).
+    /// Records `msg` on `topic` at `log_time` (ROS time; negative times are written as 0).
     pub fn write<M: RosMessage>(
         &mut self,
         topic: &str,
-        log_time: f64,
+        log_time: Time,
         msg: &M,
     ) -> Result<(), RecordError> {
-        let ns = (log_time.max(0.0) * 1e9).round() as u64;
+        let ns = log_time.as_nanos().max(0) as u64;
         let schema = format!("{}/msg/{}", M::PACKAGE, M::NAME);
         let data = slosh_msgs::to_cdr(msg);
         self.write_raw(topic, &schema, &M::ros2msg_schema(), ns, &data)
@@ -158,7 +170,7 @@ impl Recorder {
     ) -> Result<(), RecordError> {
         // A free function: `writer` below borrows `self` mutably.
         let dir = &self.dir;
-        let err = |e: mcap::McapError| write_error(dir, e);
+        let err = |e: mcap::McapError| write_error(dir, with_causes(&e));
         let Some(writer) = self.writer.as_mut() else {
             return Err(write_error(dir, "the recording is already finished"));
         };
@@ -200,11 +212,11 @@ impl Recorder {
         Ok(())
     }
 
-    /// Records the outputs of one state on `topics` (wrench, probes, pressures) at `log_time` seconds.
+    /// Records the outputs of one state on `topics` (wrench, probes, pressures) at `log_time`.
     pub fn write_outputs(
         &mut self,
         topics: &[String; 3],
-        log_time: f64,
+        log_time: Time,
         m: &crate::ros::node::OutputMessages,
     ) -> Result<(), RecordError> {
         self.write(&topics[0], log_time, &m.wrench)?;
@@ -222,7 +234,9 @@ impl Recorder {
         let Some(mut writer) = self.writer.take() else {
             return Ok(());
         };
-        writer.finish().map_err(|e| self.write_err(e))?;
+        writer
+            .finish()
+            .map_err(|e| self.write_err(with_causes(&e)))?;
         drop(writer);
         let yaml = self.metadata_yaml();
         std::fs::write(self.dir.join("metadata.yaml"), yaml).map_err(|e| self.write_err(e))
@@ -274,9 +288,13 @@ pub fn record_state(
     let stamp = slosh_msgs::builtin_interfaces::Time::from_secs_f64(o.time);
     let m = crate::ros::node::output_messages(params, tank_frame, stamp, o);
     let odom = crate::ros::motion_pub::odometry(&motion.state(o.time), stamp, "world", tank_frame);
-    rec.write("/motion/odom", o.time, &odom)?;
-    let topics = ["/wrench", "/probes", "/pressures"].map(String::from);
-    rec.write_outputs(&topics, o.time, &m)
+    rec.write("/motion/odom", stamp, &odom)?;
+    rec.write_outputs(&output_topics(), stamp, &m)
+}
+
+/// The topics `slosh run` and `slosh replay` record the outputs on: wrench, probes, pressures.
+pub fn output_topics() -> [String; 3] {
+    ["/wrench", "/probes", "/pressures"].map(String::from)
 }
 
 /// What [`repair`] recovered.

@@ -7,7 +7,6 @@ use crate::output::{write_summary, CsvOutputs, Summary};
 use crate::record::{record_state, RecordError, Recorder};
 use indicatif::{ProgressBar, ProgressStyle};
 use sph::motion::TankMotion;
-use sph::params::SimParams;
 use sph::Solver;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -41,12 +40,57 @@ pub struct RunOptions {
     pub duration: Option<f64>,
     /// Show a progress bar (on a terminal).
     pub progress: bool,
+    /// Simulated seconds per wall-clock second at most (None: as fast as possible).
+    pub rate: Option<f64>,
+}
+
+/// Records one observed state: the outputs and the motion that drove the tank up to it.
+pub type RecordState<'a> =
+    dyn FnMut(&mut Recorder, &sph::observe::Observation) -> Result<(), RecordError> + 'a;
+
+/// What drives a run besides its configuration.
+pub struct Drive<'a> {
+    pub motion: &'a dyn TankMotion,
+    /// The recording to write (None: off) and how one state is recorded.
+    pub record: Option<(Recorder, &'a mut RecordState<'a>)>,
+    /// Extra facts for `summary.json` (e.g. where a replay's motion came from).
+    pub input: Option<serde_json::Value>,
 }
 
 /// Runs a case headless into `out`; returns the summary that was also written to `out/summary.json`.
 pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
     let params = cfg.sim_params()?;
     let motion = motion_source::build(cfg)?;
+    let recorder = if cfg.config.record.path.is_empty() {
+        None
+    } else {
+        Some(Recorder::create(&cfg.config.record, &cfg.parameters)?)
+    };
+    let frame = cfg.config.frames.tank.clone();
+    let mut record = |r: &mut Recorder, o: &sph::observe::Observation| {
+        record_state(r, &params, &frame, o, motion.as_ref())
+    };
+    drive(
+        cfg,
+        out,
+        opts,
+        Drive {
+            motion: motion.as_ref(),
+            record: recorder.map(|r| (r, &mut record as &mut RecordState)),
+            input: None,
+        },
+    )
+}
+
+/// Runs a case headless into `out` under the motion and recording of `d`.
+pub fn drive(
+    cfg: &Loaded,
+    out: &Path,
+    opts: &RunOptions,
+    d: Drive<'_>,
+) -> Result<Summary, RunError> {
+    let params = cfg.sim_params()?;
+    let motion = d.motion;
     let duration = opts.duration.unwrap_or(cfg.config.duration);
     if !(duration.is_finite() && duration > 0.0) {
         return Err(crate::config::ConfigError::Key {
@@ -59,17 +103,23 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
     if duration > motion.end_time() {
         return Err(crate::config::ConfigError::Key {
             source_name: cfg.source_name.clone(),
-            key: "motion.file".into(),
-            message: format!("the motion ends at t = {} s, before the requested duration of {duration} s: shorten --duration", motion.end_time()),
+            key: "duration".into(),
+            message: format!("the motion ends at t = {:.3} s, before the requested duration of {duration} s: shorten --duration", motion.end_time()),
         }
         .into());
     }
+    if let Some(rate) = opts.rate {
+        if !(rate.is_finite() && rate > 0.0) {
+            return Err(crate::config::ConfigError::Key {
+                source_name: "--rate".into(),
+                key: "rate".into(),
+                message: format!("must be a positive factor of real time, got {rate}"),
+            }
+            .into());
+        }
+    }
     let mut outputs = CsvOutputs::create(out, &params)?;
-    let mut recorder = if cfg.config.record.path.is_empty() {
-        None
-    } else {
-        Some(Recorder::create(&cfg.config.record, &cfg.parameters)?)
-    };
+    let mut record = d.record;
     let mut sim = sph::build(params.clone()).map_err(|e| RunError::Solver {
         error: e,
         time: 0.0,
@@ -80,23 +130,26 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
     let start = Instant::now();
     let result = run_loop(
         sim.as_mut(),
-        motion.as_ref(),
+        motion,
         &mut outputs,
-        recorder
-            .as_mut()
-            .map(|r| (r, &params, cfg.config.frames.tank.as_str())),
+        record.as_mut().map(|(r, f)| (r, &mut **f)),
         &stop,
-        duration,
-        cfg.config.output_rate_hz,
+        Pace {
+            duration,
+            output_rate: cfg.config.output_rate_hz,
+            speed: opts.rate,
+        },
         &bar,
     );
     let wall = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    outputs.flush()?;
-    // The bag is finished on every path, also when the solver stopped.
-    if let Some(mut r) = recorder {
-        r.finish()?;
-    }
+    // The CSVs are flushed and the bag finished on every path, also when the solver stopped; the first
+    // failure is the one reported (a bag that failed to write usually fails to finish too).
+    let flushed = outputs.flush();
+    let finished = record.map_or(Ok(()), |(mut r, _)| r.finish());
+    let result = result
+        .and_then(|()| flushed.map_err(LoopError::Io))
+        .and_then(|()| finished.map_err(LoopError::Record));
     let (stats, counts) = (sim.stats(), sim.counts());
     let summary = Summary {
         dimension: params.dimension,
@@ -116,6 +169,7 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
         },
         liquid_mass_kg: sim.liquid_mass(),
         error: result.as_ref().err().map(|e| e.to_string()),
+        input: d.input,
         parameters: cfg.parameters.clone(),
     };
     write_summary(out, &summary)?;
@@ -147,17 +201,26 @@ enum LoopError {
     Interrupted(f64),
 }
 
-#[allow(clippy::too_many_arguments)]
+/// How long and how fast a run goes.
+struct Pace {
+    /// Simulated seconds.
+    duration: f64,
+    /// Output rows per simulated second.
+    output_rate: f64,
+    /// Simulated seconds per wall-clock second at most.
+    speed: Option<f64>,
+}
+
 fn run_loop(
     sim: &mut dyn Solver,
     motion: &dyn TankMotion,
     out: &mut CsvOutputs,
-    mut rec: Option<(&mut Recorder, &SimParams, &str)>,
+    mut rec: Option<(&mut Recorder, &mut RecordState<'_>)>,
     stop: &std::sync::atomic::AtomicBool,
-    duration: f64,
-    rate: f64,
+    pace: Pace,
     bar: &ProgressBar,
 ) -> Result<(), LoopError> {
+    let (duration, rate) = (pace.duration, pace.output_rate);
     let mut k = 0u64;
     let start = Instant::now();
     let mut last_draw = Instant::now();
@@ -167,8 +230,8 @@ fn run_loop(
         if t >= k as f64 / rate - 1e-9 {
             let o = sim.observe(motion).map_err(LoopError::Solver)?;
             out.write(&o).map_err(LoopError::Io)?;
-            if let Some((r, params, frame)) = rec.as_mut() {
-                record_state(r, params, frame, &o, motion).map_err(LoopError::Record)?;
+            if let Some((r, record)) = rec.as_mut() {
+                record(r, &o).map_err(LoopError::Record)?;
             }
             k = (t * rate + 1e-9).floor() as u64 + 1;
         }
@@ -179,6 +242,12 @@ fn run_loop(
             return Err(LoopError::Interrupted(t));
         }
         sim.step(motion).map_err(LoopError::Solver)?;
+        if let Some(speed) = pace.speed {
+            let ahead = sim.time() / speed - start.elapsed().as_secs_f64();
+            if ahead > 1e-3 {
+                std::thread::sleep(Duration::from_secs_f64(ahead));
+            }
+        }
         if last_draw.elapsed() > Duration::from_millis(200) {
             last_draw = Instant::now();
             let rtf = sim.time() / start.elapsed().as_secs_f64();

@@ -132,7 +132,7 @@ fn csv_motion_drives_the_tank_and_bad_rows_are_reported_by_line() {
         .output()
         .unwrap();
     assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("motion ends at t = 1 s"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("motion ends at t = 1.000 s"));
     // A duplicated time stamp is reported with its line.
     std::fs::write(dir.join("motion.csv"), text.replace("0.05,", "0.04,")).unwrap();
     let o = slosh()

@@ -181,3 +181,70 @@ fn sigkill_then_repair_recovers_the_complete_chunks() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_full_disk_stops_the_run_with_a_clear_error_and_keeps_the_csv_outputs() {
+    // The bag goes to a 64 KiB tmpfs in a private mount namespace (as root, or mapped to root in a user
+    // namespace), which fills up after a fraction of a second of uncompressed recording.
+    let dir = common::tmp("record-full");
+    let full = dir.join("full");
+    std::fs::create_dir_all(&full).unwrap();
+    let mut cmd = Command::new("unshare");
+    if common::euid() != 0 {
+        cmd.arg("-r");
+    }
+    let out = cmd
+        .args(["-m", "--", "sh", "-c"])
+        .arg("mount -t tmpfs -o size=64k slosh-full \"$1\" && shift && exec \"$@\"")
+        .arg("sh")
+        .arg(&full)
+        .arg(env!("CARGO_BIN_EXE_slosh"))
+        .args(["run", "seed_tank_019", "--out"])
+        .arg(dir.join("out"))
+        .args(["--duration", "2"])
+        .args(ARGS)
+        .args([
+            "--set",
+            "output_rate_hz=200",
+            "--set",
+            "record.compression=none",
+        ])
+        .args(["--set", "record.chunk_size=4096", "--set"])
+        .arg(format!("record.path={}", full.join("bag").display()))
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "the run went on: {err}");
+    assert!(
+        err.contains("recording to") && err.contains("No space left on device"),
+        "{err}"
+    );
+    // The CSVs (on another disk) hold every state up to the failure, and the summary says why it stopped.
+    let rows = common::csv(&dir.join("out/wrench.csv")).1;
+    assert!(rows.len() > 5, "{} rows", rows.len());
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert!(s["error"]
+        .as_str()
+        .unwrap()
+        .contains("No space left on device"));
+    // A folder that cannot be created stops the run before it starts.
+    let out = slosh()
+        .args(["run", "seed_tank_019", "--out"])
+        .arg(dir.join("out2"))
+        .args(["--duration", "0.1"])
+        .args(ARGS)
+        .args(["--set", "record.path=/proc/slosh/bag"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("record.path /proc/slosh/bag: cannot create the folder"),
+        "{err}"
+    );
+    assert!(!dir.join("out2/wrench.csv").exists(), "nothing was run");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -125,6 +125,7 @@ fn compare_with_run(kind: &str, domain_id: u16) {
                 "realtime.mode:=lockstep",
             ])
             .args(["-p", &format!("record.path:={}", dir.join("bag").display())])
+            .args(["-p", "particles.rate_hz:=5.0"])
             .args(match kind {
                 "accel" => ["-p", "input.accel:=true"],
                 "imu" => ["-p", "input.type:=imu"],
@@ -292,6 +293,21 @@ fn compare_with_run(kind: &str, domain_id: u16) {
         n_motion as f64 >= DURATION * 50.0,
         "{n_motion} motion samples recorded"
     );
+    // Diagnostics once the simulation runs, and the particle clouds published (5 per simulated second).
+    let diag = bag["rosbags"]["/diagnostics"]["items"].as_array().unwrap();
+    assert!(
+        diag.iter().any(|d| d[1][1] == "running"),
+        "recorded diagnostics: {diag:?}"
+    );
+    let clouds = bag["rosbags"]["/ship1/particles"]["items"]
+        .as_array()
+        .unwrap();
+    assert!(
+        clouds.len() as f64 >= DURATION * 5.0 - 1.0,
+        "{} clouds recorded",
+        clouds.len()
+    );
+    assert_eq!(clouds[0][1][0], 400, "one point per liquid particle");
     let bag_w = bag["rosbags"]["/ship1/wrench"]["items"].as_array().unwrap();
     assert_eq!(
         bag_w.len(),

@@ -262,7 +262,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             self.evaluate(motion, t, true)?;
         }
         self.rates_current = false;
-        let dt = self.time_step()?;
+        let mut dt = self.time_step()?;
+        // The last step before the motion ends lands on its end (a shorter step is always stable).
+        if t < motion.end_time() && t + dt > motion.end_time() {
+            dt = motion.end_time() - t;
+        }
         if t + dt > motion.end_time() + 1e-12 {
             return Err(SimError::MotionEnded {
                 time: t + dt,

@@ -27,6 +27,12 @@ def summarize(topic, msg):
         return [float(x) for x in msg.elevations]
     if hasattr(msg, "pressures"):
         return [float(x) for x in msg.pressures]
+    if hasattr(msg, "status"):
+        st = msg.status[0]
+        level = st.level[0] if isinstance(st.level, (bytes, bytearray)) else int(st.level)
+        return [level, st.message]
+    if hasattr(msg, "point_step"):
+        return [msg.width, msg.height, msg.point_step]
     if hasattr(msg, "pose") and hasattr(msg, "twist"):
         p = msg.pose.pose.position
         return [p.x, p.y, p.z]

@@ -18,6 +18,20 @@ pub enum Reading {
     Imu(Box<Imu>),
 }
 
+/// The tank's six coordinates (x, y, z, roll, pitch, yaw) from a received vessel pose.
+pub fn tank_coordinates(p: &Pose, frames: &Frames) -> [f64; 6] {
+    frames.tank_coordinates(position(&p.position), unit(&p.orientation))
+}
+
+/// An IMU reading in the vessel's FLU frame and the ENU world, from one received.
+pub fn imu_sample(i: &Imu, frames: &Frames) -> ImuSample {
+    ImuSample {
+        orientation: frames.vessel_orientation(unit(&i.orientation)),
+        angular_velocity: frames.body_vector(vector(&i.angular_velocity)),
+        specific_force: frames.body_vector(vector(&i.linear_acceleration)),
+    }
+}
+
 /// Received motion of either kind.
 #[derive(Debug)]
 pub enum Live {
@@ -112,18 +126,8 @@ impl Live {
     /// Adds a sample at time `t`, converted by `frames`.
     pub fn push(&mut self, t: f64, r: &Reading, frames: &Frames) -> Result<(), Rejected> {
         match (self, r) {
-            (Live::Pose(m, _), Reading::Pose(p)) => m.push(
-                t,
-                frames.tank_coordinates(position(&p.position), unit(&p.orientation)),
-            ),
-            (Live::Imu(m), Reading::Imu(i)) => m.push(
-                t,
-                ImuSample {
-                    orientation: frames.vessel_orientation(unit(&i.orientation)),
-                    angular_velocity: frames.body_vector(vector(&i.angular_velocity)),
-                    specific_force: frames.body_vector(vector(&i.linear_acceleration)),
-                },
-            ),
+            (Live::Pose(m, _), Reading::Pose(p)) => m.push(t, tank_coordinates(p, frames)),
+            (Live::Imu(m), Reading::Imu(i)) => m.push(t, imu_sample(i, frames)),
             _ => unreachable!("the input's kind is fixed at start-up"),
         }
     }

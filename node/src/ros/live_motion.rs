@@ -60,47 +60,8 @@ impl LiveMotion {
 
     /// Adds a tank pose (x, y, z, roll, pitch, yaw) at time `t`, or says why not.
     pub fn push(&mut self, t: f64, pose: [f64; 6]) -> Result<(), Rejected> {
-        if !t.is_finite() {
-            return Err(Rejected::NotFinite { what: "time" });
-        }
-        if let Some(k) = pose.iter().position(|v| !v.is_finite()) {
-            return Err(Rejected::NotFinite { what: NAMES[k] });
-        }
-        if let (Some(&t0), Some(p0)) = (self.times.back(), self.poses.back()) {
-            if t == t0 {
-                return Err(Rejected::Duplicate { time: t });
-            }
-            if t < t0 {
-                return Err(Rejected::OutOfOrder {
-                    time: t,
-                    newest: t0,
-                });
-            }
-            let dt = t - t0;
-            let dist =
-                ((pose[0] - p0[0]).powi(2) + (pose[1] - p0[1]).powi(2) + (pose[2] - p0[2]).powi(2))
-                    .sqrt();
-            if dist > self.limits.max_speed * dt {
-                return Err(Rejected::Jump {
-                    what: "position (m)",
-                    size: dist,
-                    dt,
-                    limit: self.limits.max_speed,
-                });
-            }
-            for k in 3..6 {
-                let d = pose[k] - p0[k];
-                let d = (d - (d / (2.0 * PI)).round() * 2.0 * PI).abs();
-                if d > self.limits.max_rotation_rate * dt {
-                    return Err(Rejected::Jump {
-                        what: NAMES[k],
-                        size: d,
-                        dt,
-                        limit: self.limits.max_rotation_rate,
-                    });
-                }
-            }
-        }
+        let prev = self.times.back().copied().zip(self.poses.back().copied());
+        check_pose(prev, t, &pose, &self.limits)?;
         self.times.push_back(t);
         self.poses.push_back(pose);
         self.refit();
@@ -154,6 +115,58 @@ impl LiveMotion {
     pub fn samples(&self) -> usize {
         self.times.len()
     }
+}
+
+/// Whether a tank pose (x, y, z, roll, pitch, yaw) at time `t` may follow the sample `prev`: finite, later than
+/// it, and no faster a move than `limits` allow.
+pub fn check_pose(
+    prev: Option<(f64, [f64; 6])>,
+    t: f64,
+    pose: &[f64; 6],
+    limits: &Limits,
+) -> Result<(), Rejected> {
+    if !t.is_finite() {
+        return Err(Rejected::NotFinite { what: "time" });
+    }
+    if let Some(k) = pose.iter().position(|v| !v.is_finite()) {
+        return Err(Rejected::NotFinite { what: NAMES[k] });
+    }
+    let Some((t0, p0)) = prev else {
+        return Ok(());
+    };
+    if t == t0 {
+        return Err(Rejected::Duplicate { time: t });
+    }
+    if t < t0 {
+        return Err(Rejected::OutOfOrder {
+            time: t,
+            newest: t0,
+        });
+    }
+    let dt = t - t0;
+    let dist =
+        ((pose[0] - p0[0]).powi(2) + (pose[1] - p0[1]).powi(2) + (pose[2] - p0[2]).powi(2)).sqrt();
+    if dist > limits.max_speed * dt {
+        return Err(Rejected::Jump {
+            what: "position (m)",
+            size: dist,
+            dt,
+            limit: limits.max_speed,
+        });
+    }
+    for k in 3..6 {
+        let d = pose[k] - p0[k];
+        let d = (d - (d / (2.0 * PI)).round() * 2.0 * PI).abs();
+        if d > limits.max_rotation_rate * dt {
+            return Err(Rejected::Jump {
+                what: NAMES[k],
+                size: d,
+                dt,
+                limit: limits.max_rotation_rate,
+            });
+        }
+    }
+    Ok(())
 }
 
 impl TankMotion for LiveMotion {

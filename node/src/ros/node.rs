@@ -198,7 +198,7 @@ impl Input {
             m: &M,
         ) -> anyhow::Result<()> {
             if let Some((r, topic)) = rec {
-                r.write(topic, stamp.as_secs_f64(), m)?;
+                r.write(topic, stamp, m)?;
             }
             Ok(())
         }
@@ -353,6 +353,8 @@ pub fn run(
         names.resolve("probes")?,
         names.resolve("pressures")?,
     ];
+    let diag_topic = names.resolve("/diagnostics")?;
+    let cloud_topic = names.resolve("particles")?;
     let mut recorder = if c.record.path.is_empty() {
         None
     } else {
@@ -512,6 +514,7 @@ pub fn run(
             std::thread::sleep(Duration::from_millis(2));
             maybe_diagnostics(
                 &pub_diag,
+                recorder.as_mut().map(|r| (r, diag_topic.as_str())),
                 &full_name,
                 wall(),
                 &mut last_diag,
@@ -528,7 +531,7 @@ pub fn run(
                         wall(),
                     )
                 },
-            );
+            )?;
             continue;
         };
         if !tf_sent {
@@ -610,7 +613,7 @@ pub fn run(
                     let stamp = Time::from_secs_f64(base + o.time);
                     let m = output_messages(&params, &c.frames.tank, stamp, &o);
                     if let Some(r) = recorder.as_mut() {
-                        r.write_outputs(&out_topics, stamp.as_secs_f64(), &m)?;
+                        r.write_outputs(&out_topics, stamp, &m)?;
                     }
                     publish(&pub_wrench, m.wrench, "wrench")?;
                     publish(&pub_probes, m.probes, "probes")?;
@@ -628,6 +631,9 @@ pub fn run(
                                 &sim.fluid_velocities(),
                                 c.particles.decimation,
                             );
+                            if let Some(r) = recorder.as_mut() {
+                                r.write(&cloud_topic, stamp, &cloud)?;
+                            }
                             publish(pc, cloud, "particles")?;
                             next_cloud = (t * c.particles.rate_hz + 1e-9).floor() as u64 + 1;
                         }
@@ -666,6 +672,7 @@ pub fn run(
         let w = wall();
         maybe_diagnostics(
             &pub_diag,
+            recorder.as_mut().map(|r| (r, diag_topic.as_str())),
             &full_name,
             w,
             &mut last_diag,
@@ -682,7 +689,7 @@ pub fn run(
                     w,
                 )
             },
-        );
+        )?;
         if let Some(d) = opts.duration {
             if sim.time() >= d {
                 break;
@@ -729,20 +736,30 @@ pub fn run(
     Ok(())
 }
 
+/// Publishes diagnostics if their period has passed, and records them once they carry a simulation time.
+#[allow(clippy::too_many_arguments)]
 fn maybe_diagnostics(
     p: &Publisher<DiagnosticArray>,
+    rec: Option<(&mut Recorder, &str)>,
     name: &str,
     wall: f64,
     last: &mut f64,
     rate: f64,
     make: impl FnOnce() -> DiagnosticArray,
-) {
+) -> Result<(), crate::record::RecordError> {
     if wall - *last >= 1.0 / rate {
         *last = wall;
-        if let Err(e) = p.publish(make()) {
+        let d = make();
+        if let Some((r, topic)) = rec {
+            if d.header.stamp.as_nanos() > 0 {
+                r.write(topic, d.header.stamp, &d)?;
+            }
+        }
+        if let Err(e) = p.publish(d) {
             eprintln!("[{name}] publishing /diagnostics: {e:?}");
         }
     }
+    Ok(())
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -40,7 +40,8 @@ pub fn in_private_netns(test: &str) -> bool {
     false
 }
 
-fn euid() -> u32 {
+/// The effective user id (0: root).
+pub fn euid() -> u32 {
     // `id -u` keeps this free of libc bindings.
     Command::new("id")
         .arg("-u")

@@ -1,0 +1,164 @@
+//! `slosh replay`: drives the tank with the vessel motion recorded in a rosbag2 MCAP bag, faster than real
+//! time, writing the same CSV outputs as `slosh run` and a new bag with the motion as it was recorded plus
+//! every output, all on the source bag's time axis.
+
+pub mod bag;
+pub mod motion;
+
+use crate::config::Loaded;
+use crate::output::Summary;
+use crate::record::{output_topics, RecordCfg, RecordError, Recorder};
+use crate::ros::frames::Frames;
+use crate::ros::live_motion::Limits;
+use crate::runner::{drive, Drive, RecordState, RunError, RunOptions};
+use bag::BagError;
+use slosh_msgs::builtin_interfaces::Time;
+use std::path::Path;
+
+/// What to do with a sample whose stamp repeats or goes back, that is not finite, or that jumps.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BadSamples {
+    /// Stop with an error naming the message.
+    #[default]
+    Error,
+    /// Skip the sample; the summary lists each one.
+    Drop,
+}
+
+/// What `replay.*` configures.
+#[derive(Debug, Clone, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ReplayCfg {
+    pub bad_samples: BadSamples,
+}
+
+/// Options of one replay.
+#[derive(Debug, Clone, Default)]
+pub struct ReplayOptions {
+    /// The motion topic (None: the only one in the bag).
+    pub topic: Option<String>,
+    /// Simulated seconds (None: the whole recorded motion).
+    pub duration: Option<f64>,
+    /// Simulated seconds per wall-clock second at most (None: as fast as possible).
+    pub rate: Option<f64>,
+    pub progress: bool,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    #[error(transparent)]
+    Bag(#[from] BagError),
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
+    #[error(transparent)]
+    Record(#[from] RecordError),
+    #[error(transparent)]
+    Run(#[from] RunError),
+}
+
+/// The motion a replay found, as reported before it starts.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Found {
+    pub bag: String,
+    pub topic: String,
+    #[serde(rename = "type")]
+    pub type_name: String,
+    pub messages: usize,
+    pub samples: usize,
+    pub dropped: Vec<String>,
+    /// `header` (header stamps) or `log` (the bag's log times).
+    pub time_source: String,
+    /// Stamp of the first sample (s since the epoch): the replay's t = 0.
+    pub start_stamp_s: f64,
+    /// s of motion.
+    pub span_s: f64,
+    /// The new recording.
+    pub recording: String,
+}
+
+/// Replays `bag` through the case `cfg` into `out`; `announce` is told what motion was found before the
+/// simulation starts.
+pub fn replay(
+    bag_path: &Path,
+    cfg: &Loaded,
+    out: &Path,
+    opts: &ReplayOptions,
+    announce: impl FnOnce(&Found),
+) -> Result<Summary, ReplayError> {
+    let c = &cfg.config;
+    let params = cfg.sim_params()?;
+    let files = bag::files(bag_path)?;
+    let frames = Frames::new(c.input.world_frame, c.input.body_frame, c.frames.tank_pose);
+    let how = motion::Reading {
+        topic: opts.topic.as_deref(),
+        stamp: c.input.stamp,
+        bad_samples: c.replay.bad_samples,
+        limits: Limits {
+            max_speed: c.input.max_speed,
+            max_rotation_rate: c.input.max_rotation_rate,
+        },
+        frames: &frames,
+        gravity: params.gravity,
+    };
+    let bm = motion::read(bag_path, &files, &how)?;
+    let record_cfg = if c.record.path.is_empty() {
+        RecordCfg {
+            path: out.join("bag").display().to_string(),
+            ..c.record.clone()
+        }
+    } else {
+        c.record.clone()
+    };
+    let span = bm.motion.end_time();
+    let found = Found {
+        bag: bag_path.display().to_string(),
+        topic: bm.topic.clone(),
+        type_name: bm.kind.type_name(),
+        messages: bm.total,
+        samples: bm.messages.len(),
+        dropped: bm.dropped.clone(),
+        time_source: bm.time_source.into(),
+        start_stamp_s: Time::from_nanos(bm.t0_ns).as_secs_f64(),
+        span_s: span,
+        recording: record_cfg.path.clone(),
+    };
+    announce(&found);
+    let recorder = Recorder::create(&record_cfg, &cfg.parameters)?;
+    let tank_frame = c.frames.tank.clone();
+    let topics = output_topics();
+    let mut next = 0;
+    let mut record = |r: &mut Recorder, o: &sph::observe::Observation| {
+        // The motion that drove the tank up to this state, as recorded, then the outputs.
+        let stamp_ns = bm.t0_ns + (o.time * 1e9).round() as i64;
+        while let Some((t, data)) = bm.messages.get(next).filter(|m| m.0 <= stamp_ns) {
+            r.write_raw(
+                &bm.topic,
+                &found.type_name,
+                &bm.schema,
+                (*t).max(0) as u64,
+                data,
+            )?;
+            next += 1;
+        }
+        let stamp = Time::from_nanos(stamp_ns);
+        let m = crate::ros::node::output_messages(&params, &tank_frame, stamp, o);
+        r.write_outputs(&topics, stamp, &m)
+    };
+    let run = RunOptions {
+        duration: Some(opts.duration.unwrap_or(span)),
+        progress: opts.progress,
+        rate: opts.rate,
+    };
+    let input = serde_json::to_value(&found).expect("serialises");
+    Ok(drive(
+        cfg,
+        out,
+        &run,
+        Drive {
+            motion: bm.motion.as_ref(),
+            record: Some((recorder, &mut record as &mut RecordState)),
+            input: Some(input),
+        },
+    )?)
+}

@@ -1,0 +1,347 @@
+//! `slosh replay` on bags written by a third-party tool (Python rosbags, tests/py/write_bag.py): the outputs
+//! equal `slosh run` driven by the same motion as CSV, the new recording is read by rosbags and mcap, and
+//! damaged bags get errors that name the problem.
+
+mod common;
+
+use common::{csv, slosh};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Stamp of the first motion sample in the test bags (ns since the epoch).
+const START_NS: i64 = 1_700_000_000_000_000_000;
+
+/// A barge-like motion, 50 samples per second for `seconds`: sway, heave and pitch of incommensurate
+/// periods, on a heading of 0.1 rad.
+fn motion_csv(path: &Path, seconds: f64) {
+    use std::f64::consts::TAU;
+    let mut s = String::from("time,x,y,z,roll,pitch,yaw\n");
+    let n = (seconds * 50.0).round() as usize;
+    for i in 0..=n {
+        let t = i as f64 * 0.02;
+        s += &format!(
+            "{t},{},0.0,{},0.0,{},0.1\n",
+            0.03 * (TAU * t / 1.2).sin(),
+            0.01 * (TAU * t / 1.5).sin(),
+            0.04 * (TAU * t / 1.3 + 0.3).sin()
+        );
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+/// A folder with the motion CSV and the small case driven by it.
+fn setup(name: &str, seconds: f64) -> (PathBuf, PathBuf) {
+    let (dir, case) = common::case_dir(name, "    motion: {source: csv, file: motion.csv}\n");
+    motion_csv(&dir.join("motion.csv"), seconds);
+    (dir, case)
+}
+
+/// Writes a bag from the folder's motion.csv with tests/py/write_bag.py.
+fn write_bag(dir: &Path, bag: &str, args: &[&str]) -> PathBuf {
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/py/write_bag.py");
+    let path = dir.join(bag);
+    let out = Command::new(common::python())
+        .arg(script)
+        .arg(dir.join("motion.csv"))
+        .arg(&path)
+        .arg("--start-ns")
+        .arg(START_NS.to_string())
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "write_bag.py failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    path
+}
+
+/// `slosh replay BAG --config CASE --out OUT extra...`: (success, stderr).
+fn replay(bag: &Path, case: &Path, out: &Path, extra: &[&str]) -> (bool, String) {
+    let o = slosh()
+        .arg("replay")
+        .arg(bag)
+        .arg("--config")
+        .arg(case)
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .unwrap();
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
+}
+
+fn summary(out: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn rosbags_odometry_and_pose_bags_replay_exactly_like_run_from_the_same_csv() {
+    let (dir, case) = setup("replay-equal", 1.2);
+    let st = slosh()
+        .arg("run")
+        .arg(&case)
+        .arg("--out")
+        .arg(dir.join("run"))
+        .args(["--duration", "1.0"])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let run_w = csv(&dir.join("run/wrench.csv")).1;
+    let run_p = csv(&dir.join("run/probes.csv")).1;
+    // A rosbag2 folder of Odometry, and the bare .mcap of a PoseStamped bag.
+    let odom = write_bag(&dir, "odom_bag", &["--type", "odom"]);
+    let pose = write_bag(&dir, "pose_bag", &["--type", "pose"]).join("pose_bag.mcap");
+    for (bag, topic, ty) in [
+        (odom, "/motion/odom", "nav_msgs/msg/Odometry"),
+        (pose, "/motion/pose", "geometry_msgs/msg/PoseStamped"),
+    ] {
+        let out = dir.join(format!("replay_{}", &topic[8..]));
+        let (ok, err) = replay(&bag, &case, &out, &["--duration", "1.0"]);
+        assert!(ok, "{err}");
+        let s = summary(&out);
+        assert_eq!(s["input"]["topic"], topic);
+        assert_eq!(s["input"]["type"], ty);
+        assert_eq!(s["input"]["samples"], 61);
+        assert_eq!(s["input"]["time_source"], "header");
+        assert_eq!(s["input"]["start_stamp_s"], 1.7e9);
+        // The same motion gives the same liquid: the CSVs agree to rounding.
+        let (w, p) = (
+            csv(&out.join("wrench.csv")).1,
+            csv(&out.join("probes.csv")).1,
+        );
+        assert_eq!(w.len(), run_w.len());
+        assert_eq!(p.len(), run_p.len());
+        for (a, b) in w.iter().zip(&run_w).chain(p.iter().zip(&run_p)) {
+            for (x, y) in a.iter().zip(b) {
+                assert!(
+                    (x - y).abs() <= 1e-6 * (1.0 + y.abs()),
+                    "{ty}: replay {a:?} vs run {b:?}"
+                );
+            }
+        }
+        // The new recording, read by rosbags and mcap: the motion as recorded and every output on the
+        // source bag's time axis.
+        let v = common::read_bag(&out.join("bag"));
+        for reader in ["rosbags", "mcap"] {
+            let topics: Vec<&String> = v[reader].as_object().unwrap().keys().collect();
+            assert_eq!(
+                topics,
+                [topic, "/pressures", "/probes", "/wrench"],
+                "{reader}"
+            );
+            assert_eq!(v[reader][topic]["type"], ty);
+            let motion = v[reader][topic]["items"].as_array().unwrap();
+            assert_eq!(motion.len(), 51, "{reader}: samples up to t = 1.0 s");
+            let items = v[reader]["/wrench"]["items"].as_array().unwrap();
+            assert_eq!(items.len(), w.len());
+            for (item, row) in items.iter().zip(&w) {
+                let t = item[0].as_f64().unwrap() - 1.7e9;
+                assert!((t - row[0]).abs() < 1e-6, "{reader}: log time {t}");
+                for k in 0..6 {
+                    let got = item[1][k].as_f64().unwrap();
+                    assert!((got - row[k + 1]).abs() <= 1e-6 * (1.0 + row[k + 1].abs()));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn an_imu_bag_replays_close_to_run_from_the_same_motion() {
+    // The IMU carries orientation, body rates and specific force (by finite differences in write_bag.py), not
+    // the pose: the tank feels the same apparent gravity and rotation, so the liquid agrees closely until the
+    // first wall impacts (t ≈ 1.5 s) make WCSPH's pressure noise diverge.
+    let (dir, case) = setup("replay-imu", 1.6);
+    let st = slosh()
+        .arg("run")
+        .arg(&case)
+        .arg("--out")
+        .arg(dir.join("run"))
+        .args(["--duration", "1.4"])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let bag = write_bag(&dir, "imu_bag", &["--type", "imu"]);
+    let out = dir.join("replay");
+    let (ok, err) = replay(&bag, &case, &out, &["--duration", "1.4"]);
+    assert!(ok, "{err}");
+    assert_eq!(summary(&out)["input"]["type"], "sensor_msgs/msg/Imu");
+    let (w, run_w) = (
+        csv(&out.join("wrench.csv")).1,
+        csv(&dir.join("run/wrench.csv")).1,
+    );
+    let rms = |f: &dyn Fn(usize) -> f64| {
+        ((0..w.len()).map(|i| f(i).powi(2)).sum::<f64>() / w.len() as f64).sqrt()
+    };
+    for k in [1, 3] {
+        let rel = rms(&|i| w[i][k] - run_w[i][k]) / rms(&|i| run_w[i][k]);
+        assert!(
+            rel < 0.05,
+            "wrench column {k}: {:.1} % rms from slosh run",
+            rel * 100.0
+        );
+    }
+    let (p, run_p) = (
+        csv(&out.join("probes.csv")).1,
+        csv(&dir.join("run/probes.csv")).1,
+    );
+    let worst = p
+        .iter()
+        .zip(&run_p)
+        .flat_map(|(a, b)| a[1..].iter().zip(&b[1..]).map(|(x, y)| (x - y).abs()))
+        .fold(0.0, f64::max);
+    assert!(worst < 0.006, "probes differ by up to {worst} m");
+}
+
+#[test]
+fn damaged_and_ambiguous_bags_get_errors_naming_the_problem() {
+    let (dir, case) = setup("replay-bad", 1.2);
+    let out = |n: &str| dir.join(format!("out_{n}"));
+    let fails = |bag: &Path, extra: &[&str], expect: &[&str]| {
+        let name = bag.file_name().unwrap().to_string_lossy().into_owned();
+        let (ok, err) = replay(bag, &case, &out(&name), extra);
+        assert!(!ok, "{name} replayed");
+        for e in expect {
+            assert!(err.contains(e), "{name}: `{e}` not in: {err}");
+        }
+    };
+    fails(&dir.join("missing"), &[], &["no such file or folder"]);
+    let good = write_bag(&dir, "good", &[]);
+    let truncated = dir.join("truncated.mcap");
+    let bytes = std::fs::read(good.join("good.mcap")).unwrap();
+    std::fs::write(&truncated, &bytes[..bytes.len() * 2 / 3]).unwrap();
+    fails(
+        &truncated,
+        &[],
+        &["truncated or corrupt", "slosh bag repair"],
+    );
+    let text = dir.join("text.mcap");
+    std::fs::write(&text, "time,x\n0,0\n").unwrap();
+    fails(&text, &[], &["not an MCAP file"]);
+    let sqlite = write_bag(&dir, "sqlite", &["--storage", "sqlite3"]);
+    fails(&sqlite, &[], &["storage `sqlite3`", "convert"]);
+    let none = write_bag(&dir, "none", &["--no-motion"]);
+    fails(
+        &none,
+        &[],
+        &["no motion topic", "/chatter (std_msgs/msg/String"],
+    );
+    let two = write_bag(&dir, "two", &["--second-topic", "/gps/odom"]);
+    fails(
+        &two,
+        &[],
+        &[
+            "several motion topics",
+            "/gps/odom",
+            "/motion/odom",
+            "--topic",
+        ],
+    );
+    fails(
+        &two,
+        &["--topic", "/nope"],
+        &["--topic /nope: no such topic"],
+    );
+    let chat = write_bag(&dir, "chat", &["--chatter"]);
+    fails(
+        &chat,
+        &["--topic", "/chatter"],
+        &["carries `std_msgs/msg/String`"],
+    );
+    let schema = write_bag(&dir, "schema", &["--bad-schema"]);
+    fails(
+        &schema,
+        &[],
+        &[
+            "schema is not ROS 2's",
+            "cannot decode",
+            "float64[3] position",
+        ],
+    );
+    let idl = write_bag(&dir, "idl.mcap", &["--schema-encoding", "omgidl"]);
+    fails(&idl, &[], &["unknown schema encoding `omgidl`"]);
+    let dup = write_bag(&dir, "dup", &["--duplicate", "5"]);
+    fails(
+        &dup,
+        &[],
+        &["message 7", "duplicate", "replay.bad_samples=drop"],
+    );
+    let swap = write_bag(&dir, "swap", &["--swap", "7"]);
+    fails(&swap, &[], &["message 9", "out of order"]);
+
+    // Chosen by --topic; bad samples skipped by policy and listed; zero header stamps fall back to the log
+    // times, which `input.stamp: receive` asks for directly.
+    let short = ["--duration", "0.1"];
+    let (ok, err) = replay(
+        &two,
+        &case,
+        &out("two_chosen"),
+        &[&short[..], &["--topic", "/gps/odom"]].concat(),
+    );
+    assert!(ok, "{err}");
+    assert_eq!(summary(&out("two_chosen"))["input"]["topic"], "/gps/odom");
+    let (ok, err) = replay(
+        &dup,
+        &case,
+        &out("dup_dropped"),
+        &[&short[..], &["--set", "replay.bad_samples=drop"]].concat(),
+    );
+    assert!(ok, "{err}");
+    let s = summary(&out("dup_dropped"));
+    assert_eq!(s["input"]["samples"], 61);
+    assert_eq!(s["input"]["messages"], 62);
+    let dropped = s["input"]["dropped"].as_array().unwrap();
+    assert_eq!(dropped.len(), 1);
+    assert!(dropped[0].as_str().unwrap().contains("message 7"));
+    let zero = write_bag(&dir, "zero", &["--zero-stamps"]);
+    let (ok, err) = replay(&zero, &case, &out("zero"), &short);
+    assert!(ok, "{err}");
+    let s = summary(&out("zero"));
+    assert_eq!(s["input"]["time_source"], "log");
+    // The log times are the stamps 3 ms later.
+    assert!((s["input"]["start_stamp_s"].as_f64().unwrap() - 1.700000000003e9).abs() < 1e-6);
+    let (ok, err) = replay(
+        &good,
+        &case,
+        &out("receive"),
+        &[&short[..], &["--set", "input.stamp=receive"]].concat(),
+    );
+    assert!(ok, "{err}");
+    assert_eq!(summary(&out("receive"))["input"]["time_source"], "log");
+}
+
+#[test]
+fn rate_caps_the_replay_speed_and_the_motion_bounds_the_duration() {
+    let (dir, case) = setup("replay-rate", 0.4);
+    let bag = write_bag(&dir, "bag", &[]);
+    // Pacing only ever waits, so this holds on any machine. Without --duration the whole motion is replayed.
+    let (ok, err) = replay(&bag, &case, &dir.join("paced"), &["--rate", "0.5"]);
+    assert!(ok, "{err}");
+    let s = summary(&dir.join("paced"));
+    assert!((s["sim_time_s"].as_f64().unwrap() - 0.4).abs() < 1e-9);
+    let rtf = s["realtime_factor"].as_f64().unwrap();
+    assert!(rtf <= 0.5 * 1.02, "real-time factor {rtf} above --rate 0.5");
+    assert!(
+        (rtf - s["sim_time_s"].as_f64().unwrap() / s["wall_time_s"].as_f64().unwrap()).abs() < 1e-9
+    );
+    let (ok, err) = replay(&bag, &case, &dir.join("long"), &["--duration", "5"]);
+    assert!(!ok);
+    assert!(
+        err.contains("the motion ends at t = 0.400 s") && err.contains("--duration"),
+        "{err}"
+    );
+    let (ok, err) = replay(
+        &bag,
+        &case,
+        &dir.join("both"),
+        &["--rate", "2", "--as-fast-as-possible"],
+    );
+    assert!(!ok && err.contains("cannot be used with"), "{err}");
+}
