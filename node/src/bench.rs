@@ -32,6 +32,26 @@ pub const CASES: &[Case] = &[
         overrides: &["dimension=3", "particle_spacing=0.02"],
         duration: 1.0,
     },
+    Case {
+        name: "seed_2d_dp8mm_dfsph",
+        builtin: "seed_tank_039",
+        overrides: &[
+            "dimension=2",
+            "particle_spacing=0.008",
+            "solver.scheme=dfsph",
+        ],
+        duration: 10.0,
+    },
+    Case {
+        name: "seed_3d_dp20mm_dfsph",
+        builtin: "seed_tank_039",
+        overrides: &[
+            "dimension=3",
+            "particle_spacing=0.02",
+            "solver.scheme=dfsph",
+        ],
+        duration: 5.0,
+    },
 ];
 
 #[derive(Debug, Clone, Serialize)]
@@ -46,6 +66,8 @@ pub struct BenchResult {
     pub particle_steps_per_s: f64,
     pub realtime_factor: f64,
     pub wall_s_per_sim_s: f64,
+    /// Pressure-solver iterations per step (incompressible scheme; 0 for WCSPH).
+    pub iterations_per_step: f64,
 }
 
 /// Runs one case for `duration` simulated seconds (setup excluded from the timing).
@@ -71,5 +93,6 @@ pub fn run_case(case: &Case, duration: Option<f64>) -> anyhow::Result<BenchResul
         particle_steps_per_s: stats.steps as f64 * counts.fluid as f64 / wall,
         realtime_factor: sim.time() / wall,
         wall_s_per_sim_s: wall / sim.time(),
+        iterations_per_step: stats.solver_iterations as f64 / stats.steps.max(1) as f64,
     })
 }

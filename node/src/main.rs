@@ -58,7 +58,8 @@ enum Command {
     },
     /// Time the benchmark cases: particle-steps per second and real-time factor.
     Bench {
-        /// Only this case (dambreak_2d, seed_2d_dp8mm, seed_3d_dp20mm); default: all.
+        /// Only this case (dambreak_2d, seed_2d_dp8mm, seed_3d_dp20mm, seed_2d_dp8mm_dfsph,
+        /// seed_3d_dp20mm_dfsph); default: all.
         #[arg(long)]
         case: Vec<String>,
         /// Simulated seconds per case (default: each case's own).
@@ -280,12 +281,23 @@ fn main() -> anyhow::Result<()> {
                 bench::CASES.iter().collect()
             } else {
                 case.iter()
-                    .map(|c| bench::CASES.iter().find(|k| k.name == c).with_context(|| format!("unknown case {c}; cases: dambreak_2d, seed_2d_dp8mm, seed_3d_dp20mm")))
+                    .map(|c| {
+                        bench::CASES.iter().find(|k| k.name == c).with_context(|| {
+                            format!(
+                                "unknown case {c}; cases: {}",
+                                bench::CASES
+                                    .iter()
+                                    .map(|k| k.name)
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            )
+                        })
+                    })
                     .collect::<anyhow::Result<_>>()?
             };
             if !json {
                 println!(
-                    "{:<16} {:>7} {:>9} {:>8} {:>8} {:>10} {:>14} {:>10} {:>12}",
+                    "{:<22} {:>7} {:>9} {:>8} {:>8} {:>10} {:>14} {:>10} {:>12}",
                     "case",
                     "threads",
                     "particles",
@@ -303,7 +315,7 @@ fn main() -> anyhow::Result<()> {
                     println!("{}", serde_json::to_string(&r)?);
                 } else {
                     println!(
-                        "{:<16} {:>7} {:>9} {:>8} {:>8.3} {:>10.2} {:>14.3e} {:>10.4} {:>12.1}",
+                        "{:<22} {:>7} {:>9} {:>8} {:>8.3} {:>10.2} {:>14.3e} {:>10.4} {:>12.1}",
                         r.case,
                         r.threads,
                         r.particles_fluid,

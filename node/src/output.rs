@@ -104,6 +104,10 @@ pub struct Summary {
     pub liquid_mass_kg: f64,
     /// Why the run stopped early, if it did.
     pub error: Option<String>,
+    /// The incompressible scheme's pressure solver: iterations (all, mean per step), largest mean density
+    /// error after a step's solve, steps that stopped at `max_iterations` above the tolerance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pressure_solver: Option<serde_json::Value>,
     /// Where the motion came from, for runs not driven by the config's `motion.*` (e.g. `slosh replay`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub input: Option<serde_json::Value>,

@@ -170,6 +170,15 @@ pub fn drive(
         liquid_mass_kg: sim.liquid_mass(),
         error: result.as_ref().err().map(|e| e.to_string()),
         input: d.input,
+        pressure_solver: (params.solver.scheme == sph::params::Scheme::Dfsph).then(|| {
+            serde_json::json!({
+                "iterations": stats.solver_iterations,
+                "iterations_per_step": stats.solver_iterations as f64 / stats.steps.max(1) as f64,
+                "max_density_error": stats.max_density_error,
+                "tolerance": params.solver.dfsph.max_density_error,
+                "unconverged_steps": stats.unconverged_steps,
+            })
+        }),
         parameters: cfg.parameters.clone(),
     };
     write_summary(out, &summary)?;

@@ -235,3 +235,39 @@ fn node_rejects_a_bad_parameter_at_startup_naming_it() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("motion_timeout_s"), "{err}");
 }
+
+#[test]
+fn the_incompressible_scheme_runs_and_reports_its_pressure_solver() {
+    let out = tmp("dfsph");
+    let o = slosh()
+        .args(["run", "seed_tank_019", "--out"])
+        .arg(&out)
+        .args(["--duration", "1.0"])
+        .args(["--set", "dimension=2", "--set", "particle_spacing=0.02"])
+        .args(["--set", "solver.scheme=dfsph"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let ps = &s["pressure_solver"];
+    assert_eq!(ps["unconverged_steps"], 0, "{ps}");
+    assert!(ps["max_density_error"].as_f64().unwrap() <= ps["tolerance"].as_f64().unwrap());
+    assert!(ps["iterations_per_step"].as_f64().unwrap() >= 2.0);
+    // Steps follow the flow speed: far fewer than the weakly-compressible scheme's ~4,000 a second here.
+    assert!(s["steps"].as_u64().unwrap() < 1000, "{s}");
+    // The scheme's walls are particle layers: the mirror boundary is refused by name.
+    let o = slosh()
+        .args(["run", "seed_tank_019", "--out"])
+        .arg(tmp("dfsph-mirror"))
+        .args(["--set", "solver.scheme=dfsph"])
+        .args(["--set", "solver.boundary.method=mirror"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("solver.boundary.method") && e.contains("dfsph"),
+        "{e}"
+    );
+}

@@ -41,6 +41,41 @@ impl Default for FluidSpec {
 pub enum Scheme {
     /// Weakly-compressible SPH (the paper's scheme).
     Wcsph,
+    /// Divergence-free SPH (Bender & Koschier): incompressible, time step from the flow speed.
+    Dfsph,
+}
+
+/// Settings of the divergence-free (incompressible) scheme.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DfsphSpec {
+    /// Courant number on the particle spacing: dt ≤ cfl · dp / |v|max (and ≤ cfl · sqrt(dp / |a|max)).
+    pub cfl: f64,
+    /// Largest time step, s.
+    pub dt_max: f64,
+    /// Mean predicted density error the constant-density solver reaches every step (fraction of ρ0).
+    pub max_density_error: f64,
+    /// Mean density change per step the divergence solver leaves (fraction of ρ0).
+    pub max_divergence_error: f64,
+    /// Iterations of the constant-density solver at least, and of either solver at most.
+    pub min_iterations: u32,
+    pub max_iterations: u32,
+    /// Run the divergence solver (more stable at large steps).
+    pub divergence_solve: bool,
+}
+
+impl Default for DfsphSpec {
+    fn default() -> Self {
+        Self {
+            cfl: 0.4,
+            dt_max: 0.005,
+            max_density_error: 5.0e-4,
+            max_divergence_error: 1.0e-3,
+            min_iterations: 2,
+            max_iterations: 100,
+            divergence_solve: true,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -163,6 +198,8 @@ pub struct SolverSpec {
     pub dt_max: f64,
     /// Verlet integrator: every n-th step is an Euler step.
     pub verlet_reset_steps: u32,
+    /// The divergence-free scheme's own settings (`scheme: dfsph`).
+    pub dfsph: DfsphSpec,
 }
 
 impl Default for SolverSpec {
@@ -183,6 +220,7 @@ impl Default for SolverSpec {
             dt_min: 0.0,
             dt_max: 1.0e-3,
             verlet_reset_steps: 40,
+            dfsph: DfsphSpec::default(),
         }
     }
 }
@@ -299,6 +337,33 @@ impl SimParams {
 
     /// Checks every field; the error names the first unusable one.
     pub fn validate(&self) -> Result<(), ParamError> {
+        if self.solver.scheme == Scheme::Dfsph {
+            let d = &self.solver.dfsph;
+            if self.solver.boundary.method != BoundaryMethod::Dynamic {
+                return Err(err(
+                    "solver.boundary.method",
+                    "the dfsph scheme uses the wall particle layers (`dynamic`); `mirror` is for wcsph",
+                ));
+            }
+            if !(d.cfl > 0.0 && d.cfl <= 1.0) {
+                return Err(err(
+                    "solver.dfsph.cfl",
+                    format!("must be in (0, 1], got {}", d.cfl),
+                ));
+            }
+            positive("solver.dfsph.dt_max", d.dt_max)?;
+            positive("solver.dfsph.max_density_error", d.max_density_error)?;
+            positive("solver.dfsph.max_divergence_error", d.max_divergence_error)?;
+            if d.max_iterations == 0 || d.min_iterations > d.max_iterations {
+                return Err(err(
+                    "solver.dfsph.max_iterations",
+                    format!(
+                        "must be at least 1 and at least min_iterations ({}), got {}",
+                        d.min_iterations, d.max_iterations
+                    ),
+                ));
+            }
+        }
         if self.dimension != 2 && self.dimension != 3 {
             return Err(err(
                 "dimension",

@@ -15,6 +15,11 @@ pub struct Fluid<const D: usize> {
     pub pos0: [Vec<f64>; D],
     pub vel0: [Vec<f64>; D],
     pub rho0: Vec<f64>,
+    /// Pressure solved for by an incompressible scheme, and its two parts as p/ρ² (constant-density and
+    /// divergence solver) to start the next step's solve from (kept through sorting; unused by WCSPH).
+    pub pressure: Vec<f64>,
+    pub kappa: Vec<f64>,
+    pub kappa_div: Vec<f64>,
     /// Original index of each particle (stable through sorting).
     pub id: Vec<u32>,
     // Interaction copies (f32) and cell of each particle, refreshed every force evaluation.
@@ -54,6 +59,9 @@ impl<const D: usize> Default for Fluid<D> {
             pos0: vecs(),
             vel0: vecs(),
             rho0: Vec::new(),
+            pressure: Vec::new(),
+            kappa: Vec::new(),
+            kappa_div: Vec::new(),
             id: Vec::new(),
             x: vecs(),
             v: vecs(),
@@ -96,6 +104,9 @@ impl<const D: usize> Fluid<D> {
         f.pos0 = f.pos.clone();
         f.vel0 = f.vel.clone();
         f.rho0 = f.rho.clone();
+        f.pressure = vec![0.0; points.len()];
+        f.kappa = vec![0.0; points.len()];
+        f.kappa_div = vec![0.0; points.len()];
         f.id = (0..points.len() as u32).collect();
         f
     }
@@ -136,14 +147,17 @@ impl<const D: usize> Fluid<D> {
         }
         permute(&mut self.rho, dest, s, keep);
         permute(&mut self.rho0, dest, s, keep);
+        permute(&mut self.pressure, dest, s, keep);
+        permute(&mut self.kappa, dest, s, keep);
+        permute(&mut self.kappa_div, dest, s, keep);
         permute(&mut self.id, dest, &mut scratch.u32s, keep);
         permute(&mut self.cell, dest, &mut scratch.u32s, keep);
         debug_assert!(self.cell.iter().all(|&c| c != OUTSIDE));
         n - keep
     }
 
-    /// Refreshes the f32 copies and pressures from the integrated state.
-    pub fn refresh(&mut self, eos: impl Fn(f32) -> f32 + Sync) {
+    /// Refreshes the f32 copies from the integrated state, with pressures `eos(ρ, stored pressure)`.
+    pub fn refresh(&mut self, eos: impl Fn(f32, f64) -> f32 + Sync) {
         use rayon::prelude::*;
         let n = self.len();
         for k in 0..D {
@@ -170,11 +184,11 @@ impl<const D: usize> Fluid<D> {
             .par_chunks_mut(CH)
             .zip(self.p.par_chunks_mut(CH))
             .zip(self.pr2.par_chunks_mut(CH))
-            .zip(self.rho.par_chunks(CH))
-            .for_each(|(((r, p), pr2), rho)| {
+            .zip(self.rho.par_chunks(CH).zip(self.pressure.par_chunks(CH)))
+            .for_each(|(((r, p), pr2), (rho, stored))| {
                 for i in 0..r.len() {
                     r[i] = rho[i] as f32;
-                    p[i] = eos(r[i]);
+                    p[i] = eos(r[i], stored[i]);
                     pr2[i] = p[i] / (r[i] * r[i]);
                 }
             });

@@ -12,9 +12,10 @@ use crate::kernel::Kernel;
 use crate::motion::TankMotion;
 use crate::neighbours::Grid;
 use crate::observe::probes::Shell;
-use crate::observe::{pressure, probes, Observation, Wrench};
-use crate::params::{BoundaryMethod, Integrator, SimParams};
+use crate::observe::{pressure, probes, wall_pressure, Observation, Wrench};
+use crate::params::{BoundaryMethod, Integrator, Scheme, SimParams};
 use crate::particles::{Boundary, Fluid, SortScratch};
+use crate::scheme::dfsph;
 use crate::scheme::wcsph::{self, Coefficients};
 use crate::scheme::{FrameTerms, PassTotals};
 use crate::tank::{fluid_lattice, from3, to3, wall_lattice, TankBox};
@@ -35,6 +36,16 @@ pub struct Stats {
     pub force_evaluations: u64,
     pub last_dt: f64,
     pub min_dt: f64,
+    /// Pressure-solver iterations (incompressible scheme): all steps, and the last step's (density +
+    /// divergence solver).
+    pub solver_iterations: u64,
+    pub last_iterations: u32,
+    /// Mean predicted density error after the last step's solve, and the largest over all steps (fraction
+    /// of the rest density).
+    pub last_density_error: f64,
+    pub max_density_error: f64,
+    /// Steps whose solve stopped at `max_iterations` above the tolerance.
+    pub unconverged_steps: u64,
 }
 
 pub struct Simulation<const D: usize, K: Kernel> {
@@ -57,6 +68,12 @@ pub struct Simulation<const D: usize, K: Kernel> {
     rates_current: bool,
     scratch: SortScratch,
     work: wcsph::Workspace<D>,
+    dcoef: dfsph::Coefficients,
+    dwork: dfsph::Workspace<D>,
+    /// Incompressible scheme: the walls' force and moment on the liquid integrated over the steps since the
+    /// last observation, and their duration (the observed wrench is their mean).
+    impulse: PassTotals,
+    impulse_time: f64,
 }
 
 impl<const D: usize, K: Kernel> Simulation<D, K> {
@@ -133,6 +150,26 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 0.0
             },
         };
+        let dcoef = dfsph::Coefficients {
+            h: coef.h,
+            support2: coef.support2,
+            m_fluid: coef.m_fluid,
+            m_bound: coef.m_bound,
+            rho_rest: rest_density(&kernel, &fluid, &bound, coef.m_fluid, coef.m_bound) as f32,
+            c0: coef.c0,
+            alpha: coef.alpha,
+            alpha_bound: coef.alpha_bound,
+            eta2: coef.eta2,
+            full_neighbourhood: {
+                let q = support / dp;
+                let full = if D == 2 {
+                    std::f64::consts::PI * q * q
+                } else {
+                    4.0 / 3.0 * std::f64::consts::PI * q * q * q
+                };
+                (0.6 * full) as u32
+            },
+        };
         let dt_min = if s.dt_min > 0.0 {
             s.dt_min
         } else {
@@ -159,7 +196,93 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             rates_current: false,
             scratch,
             work: Default::default(),
+            dcoef,
+            dwork: Default::default(),
+            impulse: PassTotals::default(),
+            impulse_time: 0.0,
         })
+    }
+
+    /// One step of the divergence-free scheme (see [`dfsph`]).
+    fn step_dfsph(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
+        let t = self.time;
+        let room = motion.end_time() - t;
+        if room <= 0.0 {
+            return Err(SimError::MotionEnded {
+                time: t + self.stats.last_dt.max(self.dt_min),
+                end: motion.end_time(),
+            });
+        }
+        let r = self.solve_dfsph(motion, room, false)?;
+        let spec = &self.params.solver.dfsph;
+        let st = &mut self.stats;
+        let its = r.density_iterations + r.divergence_iterations;
+        st.solver_iterations += its as u64;
+        st.last_iterations = its;
+        st.last_density_error = r.density_error;
+        st.max_density_error = st.max_density_error.max(r.density_error);
+        if !r.converged {
+            st.unconverged_steps += 1;
+        }
+        st.force_evaluations += 1 + its as u64;
+        debug_assert!(r.dt <= spec.dt_max);
+        if !(r.dt >= self.dt_min) {
+            return Err(SimError::TimeStepCollapsed {
+                time: t,
+                step: st.steps,
+                dt: r.dt,
+                dt_min: self.dt_min,
+            });
+        }
+        for k in 0..3 {
+            self.impulse.force[k] += r.totals.force[k] * r.dt;
+            self.impulse.moment[k] += r.totals.moment[k] * r.dt;
+        }
+        self.impulse_time += r.dt;
+        self.time = t + r.dt;
+        st.steps += 1;
+        st.last_dt = r.dt;
+        st.min_dt = st.min_dt.min(r.dt);
+        Ok(r.dt)
+    }
+
+    /// Sorts and refreshes the liquid, then runs the DFSPH solve of the current state: a step of at most
+    /// `room` seconds, or with `prime` only the pressures and wall force of the state (nothing moves).
+    fn solve_dfsph(
+        &mut self,
+        motion: &dyn TankMotion,
+        room: f64,
+        prime: bool,
+    ) -> Result<dfsph::StepReport, SimError> {
+        let t = self.time;
+        let frame = self.frame(motion, t);
+        self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
+        if self.fluid.is_empty() {
+            return Err(SimError::AllParticlesLost { time: t });
+        }
+        self.fluid.refresh(|_, p| p as f32);
+        let r = dfsph::step(
+            &self.kernel,
+            &self.dcoef,
+            &self.params.solver.dfsph,
+            self.params.particle_spacing,
+            &self.grid,
+            &frame,
+            &mut self.fluid,
+            &self.bound,
+            &mut self.dwork,
+            room,
+            prime,
+        );
+        if r.totals.non_finite {
+            return Err(SimError::NonFinite {
+                time: t,
+                step: self.stats.steps,
+            });
+        }
+        self.last = r.totals;
+        self.rates_current = true;
+        Ok(r)
     }
 
     /// The frame terms of the motion at t.
@@ -183,7 +306,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             }
         }
         let eos = self.eos;
-        self.fluid.refresh(|r| eos.pressure(r));
+        self.fluid.refresh(|r, _| eos.pressure(r));
         match self.params.solver.boundary.method {
             BoundaryMethod::Dynamic => dynamic::refresh(&mut self.bound, &eos),
             BoundaryMethod::Mirror => {
@@ -257,6 +380,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     /// Advances one time step; returns its length.
     pub fn step(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
+        if self.params.solver.scheme == Scheme::Dfsph {
+            return self.step_dfsph(motion);
+        }
         let t = self.time;
         if !self.rates_current {
             self.evaluate(motion, t, true)?;
@@ -325,7 +451,15 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     /// Observables of the current state (evaluates the rates of the current state if the last step did not).
     pub fn observe(&mut self, motion: &dyn TankMotion) -> Result<Observation, SimError> {
-        if !self.rates_current {
+        if self.params.solver.scheme == Scheme::Dfsph {
+            // The last step's pressures and wall force (or a solve of this state if no step made them),
+            // with the particles where they are now.
+            if !self.rates_current {
+                self.solve_dfsph(motion, self.params.solver.dfsph.dt_max, true)?;
+            }
+            self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
+            self.fluid.refresh(|_, p| p as f32);
+        } else if !self.rates_current {
             self.evaluate(motion, self.time, true)?;
             self.rates_current = true;
         }
@@ -350,11 +484,34 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 )
             })
             .collect();
+        let dfsph = self.params.solver.scheme == Scheme::Dfsph;
         let pressures = self
             .params
             .pressure_sensors
             .iter()
-            .map(|s| pressure::pressure(k, &self.grid, &self.fluid, m, from3([s.x, s.y, s.z])))
+            .map(|s| {
+                let at: [f64; D] = from3([s.x, s.y, s.z]);
+                match wall_pressure::face_of(&self.tank, at, 0.5 * dp) {
+                    Some(face) if dfsph => {
+                        let f = &self.fluid;
+                        wall_pressure::wall_pressure(
+                            k,
+                            &self.grid,
+                            f,
+                            &self.bound,
+                            |i| f.kappa[i] + f.kappa_div[i],
+                            (
+                                self.coef.m_fluid as f64,
+                                self.coef.m_bound as f64,
+                                dfsph::MIRROR as f64,
+                            ),
+                            at,
+                            face,
+                        )
+                    }
+                    _ => pressure::pressure(k, &self.grid, &self.fluid, m, at),
+                }
+            })
             .collect();
         // The boundary's force on the liquid, reversed; a 2D result stands for the tank's breadth.
         let scale = if D == 2 {
@@ -362,9 +519,23 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         } else {
             -1.0
         };
+        // The incompressible scheme's wall force comes in impulses of one step: its wrench is the mean over
+        // the steps since the last observation.
+        let (force, moment) = if dfsph && self.impulse_time > 0.0 {
+            let t = self.impulse_time;
+            let f = (
+                self.impulse.force.map(|v| v / t),
+                self.impulse.moment.map(|v| v / t),
+            );
+            self.impulse = PassTotals::default();
+            self.impulse_time = 0.0;
+            f
+        } else {
+            (self.last.force, self.last.moment)
+        };
         let wrench = Wrench {
-            force: self.last.force.map(|v| v * scale),
-            moment: self.last.moment.map(|v| v * scale),
+            force: force.map(|v| v * scale),
+            moment: moment.map(|v| v * scale),
         };
         Ok(Observation {
             time: self.time,
@@ -429,6 +600,47 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         }
         self.rates_current = false;
     }
+}
+
+/// The density a liquid particle inside the initial lattice sums to (the incompressible scheme holds it):
+/// that of the particle nearest the middle of the liquid block.
+fn rest_density<const D: usize, K: Kernel>(
+    k: &K,
+    fluid: &Fluid<D>,
+    bound: &Boundary<D>,
+    m_fluid: f32,
+    m_bound: f32,
+) -> f64 {
+    let n = fluid.len();
+    let centre: [f64; D] =
+        std::array::from_fn(|d| fluid.pos[d].iter().sum::<f64>() / n.max(1) as f64);
+    let dist2 = |i: usize| {
+        (0..D)
+            .map(|d| (fluid.pos[d][i] - centre[d]).powi(2))
+            .sum::<f64>()
+    };
+    let Some(a) = (0..n).min_by(|&i, &j| dist2(i).total_cmp(&dist2(j))) else {
+        return 0.0;
+    };
+    let xa = fluid.position(a);
+    let support = k.support() as f64;
+    let sum = |m: f32, count: usize, at: &dyn Fn(usize) -> [f64; D]| {
+        (0..count)
+            .map(|j| {
+                let x = at(j);
+                let r = (0..D).map(|d| (x[d] - xa[d]).powi(2)).sum::<f64>().sqrt();
+                if r < support {
+                    m as f64 * k.w(r as f32) as f64
+                } else {
+                    0.0
+                }
+            })
+            .sum::<f64>()
+    };
+    sum(m_fluid, n, &|j| fluid.position(j))
+        + sum(m_bound, bound.len(), &|j| {
+            std::array::from_fn(|d| bound.x[d][j] as f64)
+        })
 }
 
 /// A simulation of any dimension and kernel, chosen at run time.

