@@ -337,6 +337,8 @@ pub enum RealtimeMode {
 #[serde(deny_unknown_fields, default)]
 pub struct RealtimeCfg {
     pub mode: RealtimeMode,
+    /// Choose `particle_spacing` at start-up from a timed trial so that `realtime` mode keeps up.
+    pub auto_resolution: crate::resolution::AutoResolutionCfg,
 }
 
 /// A loaded configuration: the typed parameters, where they came from, and the merged parameter tree.

@@ -10,5 +10,6 @@ pub mod motion_source;
 pub mod output;
 pub mod record;
 pub mod replay;
+pub mod resolution;
 pub mod ros;
 pub mod runner;

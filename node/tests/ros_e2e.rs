@@ -733,3 +733,62 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
     assert!(status.success(), "exit after SIGTERM: {status}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
+    if !common::in_private_netns("realtime_mode_chooses_the_resolution_from_a_timed_trial") {
+        return;
+    }
+    let dir = common::tmp("ros-autores");
+    let case = dir.join("case.yaml");
+    // The incompressible scheme at dp 10 mm at most, 40 mm at least; trials of 0.2 s of the case's sway.
+    std::fs::write(
+        &case,
+        common::small_case(
+            "    diagnostics_rate_hz: 10.0\n    solver: {scheme: dfsph}\n    motion: {source: regular, regular: {amplitude: [0.01, 0, 0, 0, 0, 0], period: [1.2, 0, 0, 0, 0, 0], phase: [0, 0, 0, 0, 0, 0]}}\n    realtime: {auto_resolution: {enabled: true, max_spacing: 0.04, trial_s: 0.2, target_factor: 1.2}}\n",
+        )
+        .replace("particle_spacing: 0.02", "particle_spacing: 0.01"),
+    )
+    .unwrap();
+    let (_ctx, mut node) = test_node(47, "e2e_autores");
+    let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
+    let _proc = Kill(
+        slosh()
+            .args(["node", "--ros-args", "--params-file"])
+            .arg(&case)
+            .env("ROS_DOMAIN_ID", "47")
+            .spawn()
+            .unwrap(),
+    );
+    let start = Instant::now();
+    let values = loop {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no diagnostics from the node"
+        );
+        if let Ok(Some((m, _))) = diags.take() {
+            break m.status[0].values.clone();
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let get = |k: &str| {
+        values
+            .iter()
+            .find(|v| v.key == k)
+            .unwrap_or_else(|| panic!("no {k} in {values:?}"))
+            .value
+            .clone()
+    };
+    let dp: f64 = get("particle_spacing").parse().unwrap();
+    let how = get("auto_resolution");
+    // One of the candidates 0.01 · 1.25^n up to 0.04, and the diagnostics say how it was chosen.
+    assert!(
+        (0..=6).any(|n| (dp - 0.01 * 1.25f64.powi(n)).abs() < 1e-9) && dp <= 0.04,
+        "particle_spacing {dp}"
+    );
+    assert!(
+        how.contains(&format!("dp {dp:.4} m")) && how.contains("trial real-time factor"),
+        "{how}"
+    );
+    assert_eq!(get("scheme"), "dfsph");
+}

@@ -171,6 +171,8 @@ struct Counters {
     last_reject: String,
     published: u64,
     timeouts: u64,
+    /// How the particle spacing was chosen (`realtime.auto_resolution`).
+    resolution: String,
 }
 
 enum Input {
@@ -235,9 +237,23 @@ pub fn run(
     opts: &NodeOptionsCli,
 ) -> anyhow::Result<()> {
     let cfg = load_parameters(ros, fallback_params)?;
-    let params = cfg.sim_params()?;
+    let mut params = cfg.sim_params()?;
     let names = Names::new(ros, DEFAULT_NAME)?;
     let c = &cfg.config;
+    let auto = &c.realtime.auto_resolution;
+    let resolution = if auto.enabled && c.realtime.mode == RealtimeMode::Realtime {
+        eprintln!(
+            "[{}] realtime.auto_resolution: timing {} s trials of {} ...",
+            names.node, auto.trial_s, cfg.source_name
+        );
+        let choice = crate::resolution::choose(&cfg, auto)?;
+        params.particle_spacing = choice.particle_spacing;
+        choice.describe()
+    } else if auto.enabled {
+        "off (only in realtime mode)".to_string()
+    } else {
+        "off".to_string()
+    };
     if !(c.motion_timeout_s.is_finite() && c.motion_timeout_s > 0.0) {
         anyhow::bail!(
             "{}: motion_timeout_s: must be a positive number of seconds, got {}",
@@ -377,7 +393,7 @@ pub fn run(
     log(
         ros2_client::ros2::LogLevel::Info,
         &format!(
-            "{}: {}D tank {} x {} x {} m, {} liquid + {} wall particles, {:?} mode; waiting for motion on {}",
+            "{}: {}D tank {} x {} x {} m, {} liquid + {} wall particles (dp {} m, auto resolution: {}), {:?} mode; waiting for motion on {}",
             cfg.source_name,
             params.dimension,
             params.tank.length,
@@ -385,6 +401,8 @@ pub fn run(
             params.tank.height,
             counts.fluid,
             counts.boundary,
+            params.particle_spacing,
+            resolution,
             c.realtime.mode,
             in_topic
         ),
@@ -393,7 +411,10 @@ pub fn run(
     let start = Instant::now();
     let wall = || start.elapsed().as_secs_f64();
     let mut pacing = Pacing::new(0.25);
-    let mut counters = Counters::default();
+    let mut counters = Counters {
+        resolution,
+        ..Default::default()
+    };
     let mut t0: Option<f64> = None;
     let rate = c.output_rate_hz;
     let mut next_output = 0u64;
@@ -804,6 +825,11 @@ fn diagnostics(
                     "scheme",
                     format!("{:?}", sim.params().solver.scheme).to_lowercase(),
                 ),
+                kv(
+                    "particle_spacing",
+                    sim.params().particle_spacing.to_string(),
+                ),
+                kv("auto_resolution", c.resolution.clone()),
                 kv("time_step_s", format!("{:.6}", stats.last_dt)),
                 kv("pressure_iterations", stats.last_iterations.to_string()),
                 kv("density_error", format!("{:.2e}", stats.last_density_error)),
