@@ -131,19 +131,22 @@ enum BagCommand {
     },
 }
 
+/// A path beside `bag` named after it with `suffix` (`runs/ship1` → `runs/ship1_replay`).
+fn beside(bag: &std::path::Path, suffix: &str) -> PathBuf {
+    let name = bag
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    bag.with_file_name(format!("{name}{suffix}"))
+}
+
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Bag {
             command: BagCommand::Repair { bag, out },
         } => {
-            let out = out.unwrap_or_else(|| {
-                let name = bag
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_default();
-                bag.with_file_name(format!("{name}_repaired"))
-            });
+            let out = out.unwrap_or_else(|| beside(&bag, "_repaired"));
             let r = slosh_node::record::repair(&bag, &out)?;
             println!(
                 "recovered {} messages on {} topics into {}{}",
@@ -239,13 +242,7 @@ fn main() -> anyhow::Result<()> {
             set,
         } => {
             let loaded = config::load(&cfg, &set)?;
-            let out = out.unwrap_or_else(|| {
-                let name = bag
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_default();
-                bag.with_file_name(format!("{name}_replay"))
-            });
+            let out = out.unwrap_or_else(|| beside(&bag, "_replay"));
             let opts = slosh_node::replay::ReplayOptions {
                 topic,
                 duration,

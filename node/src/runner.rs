@@ -4,7 +4,7 @@
 use crate::config::Loaded;
 use crate::motion_source;
 use crate::output::{write_summary, CsvOutputs, Summary};
-use crate::record::{record_state, RecordError, Recorder};
+use crate::record::{record_state, RecordCfg, RecordError, Recorder};
 use indicatif::{ProgressBar, ProgressStyle};
 use sph::motion::TankMotion;
 use sph::Solver;
@@ -51,8 +51,9 @@ pub type RecordState<'a> =
 /// What drives a run besides its configuration.
 pub struct Drive<'a> {
     pub motion: &'a dyn TankMotion,
-    /// The recording to write (None: off) and how one state is recorded.
-    pub record: Option<(Recorder, &'a mut RecordState<'a>)>,
+    /// The recording to create once the run's options are checked (None: off), and how one state is
+    /// recorded.
+    pub record: Option<(RecordCfg, &'a mut RecordState<'a>)>,
     /// Extra facts for `summary.json` (e.g. where a replay's motion came from).
     pub input: Option<serde_json::Value>,
 }
@@ -61,11 +62,6 @@ pub struct Drive<'a> {
 pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
     let params = cfg.sim_params()?;
     let motion = motion_source::build(cfg)?;
-    let recorder = if cfg.config.record.path.is_empty() {
-        None
-    } else {
-        Some(Recorder::create(&cfg.config.record, &cfg.parameters)?)
-    };
     let frame = cfg.config.frames.tank.clone();
     let mut record = |r: &mut Recorder, o: &sph::observe::Observation| {
         record_state(r, &params, &frame, o, motion.as_ref())
@@ -76,7 +72,8 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
         opts,
         Drive {
             motion: motion.as_ref(),
-            record: recorder.map(|r| (r, &mut record as &mut RecordState)),
+            record: (!cfg.config.record.path.is_empty())
+                .then(|| (cfg.config.record.clone(), &mut record as &mut RecordState)),
             input: None,
         },
     )
@@ -118,8 +115,11 @@ pub fn drive(
             .into());
         }
     }
+    let mut record = match d.record {
+        Some((rc, f)) => Some((Recorder::create(&rc, &cfg.parameters)?, f)),
+        None => None,
+    };
     let mut outputs = CsvOutputs::create(out, &params)?;
-    let mut record = d.record;
     let mut sim = sph::build(params.clone()).map_err(|e| RunError::Solver {
         error: e,
         time: 0.0,

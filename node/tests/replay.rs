@@ -337,6 +337,8 @@ fn rate_caps_the_replay_speed_and_the_motion_bounds_the_duration() {
         err.contains("the motion ends at t = 0.400 s") && err.contains("--duration"),
         "{err}"
     );
+    // Refused before anything is written: no empty bag is left to block the next try.
+    assert!(!dir.join("long/bag").exists());
     let (ok, err) = replay(
         &bag,
         &case,

@@ -151,15 +151,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             },
         };
         let dcoef = dfsph::Coefficients {
-            h: coef.h,
-            support2: coef.support2,
-            m_fluid: coef.m_fluid,
-            m_bound: coef.m_bound,
+            pair: coef,
             rho_rest: rest_density(&kernel, &fluid, &bound, coef.m_fluid, coef.m_bound) as f32,
-            c0: coef.c0,
-            alpha: coef.alpha,
-            alpha_bound: coef.alpha_bound,
-            eta2: coef.eta2,
             full_neighbourhood: {
                 let q = support / dp;
                 let full = if D == 2 {

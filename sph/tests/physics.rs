@@ -166,8 +166,8 @@ fn tank_at_rest_is_hydrostatic_with_mirror_boundaries() {
     check_hydrostatics(p, 1.0);
 }
 
-#[test]
-fn tank_at_rest_is_hydrostatic_in_3d_with_the_wendland_kernel() {
+/// A small 3D tank with the Wendland kernel, probes in a corner and the middle, a wall sensor 2.5 dp up.
+fn tank3d_wendland() -> SimParams {
     let mut p = tank2d(0.4, 0.3, 0.15, 0.02);
     p.dimension = 3;
     p.tank.breadth = 0.2;
@@ -186,7 +186,12 @@ fn tank_at_rest_is_hydrostatic_in_3d_with_the_wendland_kernel() {
         y: 0.0,
         z: 0.05,
     }];
-    check_hydrostatics(p, 0.5);
+    p
+}
+
+#[test]
+fn tank_at_rest_is_hydrostatic_in_3d_with_the_wendland_kernel() {
+    check_hydrostatics(tank3d_wendland(), 0.5);
 }
 
 /// Period of a signal from its upward zero crossings (interpolated), after removing its mean.
@@ -203,16 +208,19 @@ fn period(t: &[f64], y: &[f64]) -> f64 {
     (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64
 }
 
-#[test]
-fn first_sloshing_mode_has_the_linear_frequency() {
-    // Free decay of the first mode from its velocity field at zero elevation (linear potential flow):
-    // phi = B cos(k x') cosh(k z) with x' from the left wall, B = a w / (k sinh(k h)).
-    // Mirror (free-slip) walls, as linear theory assumes inviscid flow; kh = π/4.
+/// Free decay of the first mode from its velocity field at zero elevation (linear potential flow):
+/// phi = B cos(k x') cosh(k z) with x' from the left wall, B = a w / (k sinh(k h)); 1 m tank, 0.25 m deep
+/// (kh = π/4), a = 1 cm. `setup` chooses the scheme and walls. Returns the simulation, the observation
+/// times, the elevation near the left wall and Fx over 3.3 periods, the largest elevation, the linear
+/// period and a.
+#[allow(clippy::type_complexity)]
+fn first_mode(
+    setup: impl FnOnce(&mut SimParams),
+) -> (Box<dyn Solver>, Vec<f64>, Vec<f64>, Vec<f64>, f64, f64, f64) {
     let (l, h, a) = (1.0, 0.25, 0.01);
     let mut p = tank2d(l, 0.6, h, 0.02);
-    p.solver.sound_speed_coefficient = 10.0;
-    p.solver.boundary.method = BoundaryMethod::Mirror;
     p.probes = vec![probe("left", -0.45)];
+    setup(&mut p);
     let k = std::f64::consts::PI / l;
     let w = (G * k * (k * h).tanh()).sqrt();
     let b = a * w / (k * (k * h).sinh());
@@ -235,7 +243,16 @@ fn first_sloshing_mode_has_the_linear_frequency() {
         fx.push(o.wrench.force[0]);
         amp = amp.max((o.probes[0] - h).abs());
     }
-    let expect = 2.0 * std::f64::consts::PI / w;
+    (sim, ts, eta, fx, amp, 2.0 * std::f64::consts::PI / w, a)
+}
+
+#[test]
+fn first_sloshing_mode_has_the_linear_frequency() {
+    // Mirror (free-slip) walls, as linear theory assumes inviscid flow.
+    let (_, ts, eta, fx, amp, expect, a) = first_mode(|p| {
+        p.solver.sound_speed_coefficient = 10.0;
+        p.solver.boundary.method = BoundaryMethod::Mirror;
+    });
     let t_probe = period(&ts, &eta);
     let t_force = period(&ts, &fx);
     assert!(
@@ -250,23 +267,25 @@ fn first_sloshing_mode_has_the_linear_frequency() {
     assert!(amp > 0.6 * a && amp < 1.4 * a, "amplitude {amp}");
 }
 
-#[test]
-fn dam_break_front_follows_martin_and_moyce() {
-    // Martin & Moyce (1952), square-based column n² = 2: T = t sqrt(2g/a), front Z/a (Phil. Trans. A 244, Fig. 3).
-    const MM: [(f64, f64); 4] = [(1.22, 1.47), (2.00, 2.29), (2.55, 3.00), (3.35, 4.13)];
+/// Martin & Moyce (1952), square-based column n² = 2: T = t sqrt(2g/a), front Z/a (Phil. Trans. A 244, Fig. 3).
+const MARTIN_MOYCE: [(f64, f64); 4] = [(1.22, 1.47), (2.00, 2.29), (2.55, 3.00), (3.35, 4.13)];
+
+/// The dam-break case: a 0.2 m wide, 0.4 m high column against the left wall of a 1.2 m tank, dp = 5 mm.
+fn dam_break() -> SimParams {
     let a = 0.2;
     let mut p = tank2d(1.2, 0.6, 2.0 * a, 0.005);
     p.fill.length = a;
-    p.solver.kernel = KernelKind::Wendland;
-    p.solver.smoothing_ratio = 2f64.sqrt();
-    p.solver.integrator = Integrator::Verlet;
-    p.solver.sound_speed_coefficient = 20.0;
-    p.solver.boundary.layers = 1;
-    p.solver.artificial_viscosity.boundary_factor = 1.0;
+    p
+}
+
+/// Runs the dam break `p` and checks its front against Martin & Moyce; returns the simulation.
+fn check_dam_break(p: SimParams) -> Box<dyn Solver> {
+    let a = p.fill.length;
+    let scheme = p.solver.scheme;
     let mut sim = sph::build(p).unwrap();
     let n0 = sim.counts().fluid;
     let left = -0.6;
-    for (t_star, z_expect) in MM {
+    for (t_star, z_expect) in MARTIN_MOYCE {
         let t = t_star / (2.0 * G / a).sqrt();
         sim.advance_to(&AtRest, t).unwrap();
         let front = sim
@@ -276,7 +295,7 @@ fn dam_break_front_follows_martin_and_moyce() {
             .fold(f64::MIN, f64::max)
             - left;
         let z = front / a;
-        eprintln!("T = {t_star}: front Z/a = {z:.3}, Martin & Moyce {z_expect}");
+        eprintln!("{scheme:?} T = {t_star}: front Z/a = {z:.3}, Martin & Moyce {z_expect}");
         // Never slower than the experiment, never faster than inviscid shallow water (Ritter: Z/a = 1 + 2T).
         assert!(
             z > 0.97 * z_expect && z < 1.0 + 2.0 * t_star,
@@ -292,6 +311,19 @@ fn dam_break_front_follows_martin_and_moyce() {
         }
     }
     assert_eq!(sim.counts().fluid, n0, "particles lost");
+    sim
+}
+
+#[test]
+fn dam_break_front_follows_martin_and_moyce() {
+    let mut p = dam_break();
+    p.solver.kernel = KernelKind::Wendland;
+    p.solver.smoothing_ratio = 2f64.sqrt();
+    p.solver.integrator = Integrator::Verlet;
+    p.solver.sound_speed_coefficient = 20.0;
+    p.solver.boundary.layers = 1;
+    p.solver.artificial_viscosity.boundary_factor = 1.0;
+    check_dam_break(p);
 }
 
 /// Smoothly ramped constant acceleration along x: a(t) = a0 r(t) with a half-cosine ramp over `ramp` s.
@@ -314,10 +346,11 @@ impl Dof6Motion for Accelerating {
     }
 }
 
-#[test]
-fn accelerating_tank_tilts_the_surface_and_pushes_back() {
+/// The seed tank accelerated at 1 m/s² along x: the surface tilts to the apparent gravity and the liquid
+/// pushes back with m a0.
+fn check_accelerating(p: SimParams) {
     let a0 = 1.0;
-    let mut p = tank2d(0.8, 0.6, 0.39, 0.02);
+    let mut p = p;
     p.probes = vec![probe("left", -0.3), probe("right", 0.3)];
     let mut sim = sph::build(p).unwrap();
     let mass = sim.liquid_mass();
@@ -338,6 +371,11 @@ fn accelerating_tank_tilts_the_surface_and_pushes_back() {
         -mass * a0
     );
     assert!((o.wrench.force[2] + mass * G).abs() < 0.01 * mass * G);
+}
+
+#[test]
+fn accelerating_tank_tilts_the_surface_and_pushes_back() {
+    check_accelerating(tank2d(0.8, 0.6, 0.39, 0.02));
 }
 
 #[test]
@@ -526,56 +564,13 @@ fn dfsph_tank_at_rest_is_hydrostatic_and_the_solver_converges_every_step() {
 
 #[test]
 fn dfsph_tank_at_rest_is_hydrostatic_in_3d_with_the_wendland_kernel() {
-    let mut p = dfsph(tank2d(0.4, 0.3, 0.15, 0.02));
-    p.dimension = 3;
-    p.tank.breadth = 0.2;
-    p.solver.kernel = KernelKind::Wendland;
-    p.probes = vec![
-        ProbeSpec {
-            name: "corner".into(),
-            x: -0.17,
-            y: 0.07,
-        },
-        probe("mid", 0.0),
-    ];
-    p.pressure_sensors = vec![SensorSpec {
-        name: "left".into(),
-        x: -0.2,
-        y: 0.0,
-        z: 0.05,
-    }];
     // The wall sensor 2.5 dp above the floor reads 5.6 % low here (a known gap; 5 % is the WCSPH bar).
-    check_hydrostatics_within(p, 0.5, 0.4, 0.08);
+    check_hydrostatics_within(dfsph(tank3d_wendland()), 0.5, 0.4, 0.08);
 }
 
 #[test]
 fn dfsph_first_sloshing_mode_has_the_linear_frequency() {
-    let (l, h, a) = (1.0, 0.25, 0.01);
-    let mut p = dfsph(tank2d(l, 0.6, h, 0.02));
-    p.probes = vec![probe("left", -0.45)];
-    let k = std::f64::consts::PI / l;
-    let w = (G * k * (k * h).tanh()).sqrt();
-    let b = a * w / (k * (k * h).sinh());
-    let mut sim = sph::build(p).unwrap();
-    sim.set_fluid_velocity(&|x: [f64; 3]| {
-        let xs = x[0] + l / 2.0;
-        [
-            -b * k * (k * xs).sin() * (k * x[2]).cosh(),
-            0.0,
-            b * k * (k * xs).cos() * (k * x[2]).sinh(),
-        ]
-    });
-    let (mut ts, mut eta, mut fx) = (vec![], vec![], vec![]);
-    let mut amp: f64 = 0.0;
-    for i in 1..=((3.3 * 2.0 * std::f64::consts::PI / w) / 0.01) as usize {
-        sim.advance_to(&AtRest, i as f64 * 0.01).unwrap();
-        let o = sim.observe(&AtRest).unwrap();
-        ts.push(o.time);
-        eta.push(o.probes[0]);
-        fx.push(o.wrench.force[0]);
-        amp = amp.max((o.probes[0] - h).abs());
-    }
-    let expect = 2.0 * std::f64::consts::PI / w;
+    let (sim, ts, eta, fx, amp, expect, a) = first_mode(|p| p.solver.scheme = Scheme::Dfsph);
     // The wall force carries the solver's step-to-step pressure noise: its period is read from the 0.3 s
     // running mean.
     let smooth: Vec<f64> = (0..fx.len())
@@ -602,62 +597,14 @@ fn dfsph_first_sloshing_mode_has_the_linear_frequency() {
 
 #[test]
 fn dfsph_dam_break_front_follows_martin_and_moyce() {
-    const MM: [(f64, f64); 4] = [(1.22, 1.47), (2.00, 2.29), (2.55, 3.00), (3.35, 4.13)];
-    let a = 0.2;
-    let mut p = dfsph(tank2d(1.2, 0.6, 2.0 * a, 0.005));
-    p.fill.length = a;
+    let mut p = dfsph(dam_break());
     p.solver.artificial_viscosity.boundary_factor = 1.0;
-    let mut sim = sph::build(p).unwrap();
-    let n0 = sim.counts().fluid;
-    let left = -0.6;
-    for (t_star, z_expect) in MM {
-        let t = t_star / (2.0 * G / a).sqrt();
-        sim.advance_to(&AtRest, t).unwrap();
-        let front = sim
-            .fluid_positions()
-            .iter()
-            .map(|x| x[0])
-            .fold(f64::MIN, f64::max)
-            - left;
-        let z = front / a;
-        eprintln!("dfsph T = {t_star}: front Z/a = {z:.3}, Martin & Moyce {z_expect}");
-        assert!(
-            z > 0.97 * z_expect && z < 1.0 + 2.0 * t_star,
-            "T = {t_star}: front Z/a = {z:.3}, Martin & Moyce {z_expect}"
-        );
-        if t_star > 3.0 {
-            assert!(
-                (z - z_expect).abs() < 0.10 * z_expect,
-                "T = {t_star}: front Z/a = {z:.3}, Martin & Moyce {z_expect}"
-            );
-        }
-    }
-    assert_eq!(sim.counts().fluid, n0, "particles lost");
-    let s = sim.stats();
-    eprintln!("dfsph dam break: {s:?}");
-    assert_eq!(s.unconverged_steps, 0);
+    let sim = check_dam_break(p);
+    eprintln!("dfsph dam break: {:?}", sim.stats());
+    assert_eq!(sim.stats().unconverged_steps, 0);
 }
 
 #[test]
 fn dfsph_accelerating_tank_tilts_the_surface_and_pushes_back() {
-    let a0 = 1.0;
-    let mut p = dfsph(tank2d(0.8, 0.6, 0.39, 0.02));
-    p.probes = vec![probe("left", -0.3), probe("right", 0.3)];
-    let mut sim = sph::build(p).unwrap();
-    let mass = sim.liquid_mass();
-    let m = Accelerating { a0, ramp: 3.0 };
-    let o = run_and_average(sim.as_mut(), &m, 4.0, 5.0, 0.01);
-    let slope = (o.probes[0] - o.probes[1]) / 0.6;
-    assert!(
-        (slope - a0 / G).abs() < 0.1 * a0 / G,
-        "slope {slope}, expected {}",
-        a0 / G
-    );
-    assert!(
-        (o.wrench.force[0] + mass * a0).abs() < 0.05 * mass * a0,
-        "fx {} vs {}",
-        o.wrench.force[0],
-        -mass * a0
-    );
-    assert!((o.wrench.force[2] + mass * G).abs() < 0.01 * mass * G);
+    check_accelerating(dfsph(tank2d(0.8, 0.6, 0.39, 0.02)));
 }

@@ -7,7 +7,7 @@ pub mod motion;
 
 use crate::config::Loaded;
 use crate::output::Summary;
-use crate::record::{output_topics, RecordCfg, RecordError, Recorder};
+use crate::record::{output_topics, RecordCfg, Recorder};
 use crate::ros::frames::Frames;
 use crate::ros::live_motion::Limits;
 use crate::runner::{drive, Drive, RecordState, RunError, RunOptions};
@@ -51,8 +51,6 @@ pub enum ReplayError {
     Bag(#[from] BagError),
     #[error(transparent)]
     Config(#[from] crate::config::ConfigError),
-    #[error(transparent)]
-    Record(#[from] RecordError),
     #[error(transparent)]
     Run(#[from] RunError),
 }
@@ -124,7 +122,6 @@ pub fn replay(
         recording: record_cfg.path.clone(),
     };
     announce(&found);
-    let recorder = Recorder::create(&record_cfg, &cfg.parameters)?;
     let tank_frame = c.frames.tank.clone();
     let topics = output_topics();
     let mut next = 0;
@@ -157,7 +154,7 @@ pub fn replay(
         &run,
         Drive {
             motion: bm.motion.as_ref(),
-            record: Some((recorder, &mut record as &mut RecordState)),
+            record: Some((record_cfg, &mut record as &mut RecordState)),
             input: Some(input),
         },
     )?)

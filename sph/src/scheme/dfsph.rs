@@ -20,7 +20,7 @@
 //! lists; every pass is a gather over fixed chunks that writes only its own particles, so results do not
 //! depend on the number of threads.
 
-use super::{FrameTerms, PassTotals};
+use super::{FrameTerms, PassTotals, CHUNK};
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DfsphSpec;
@@ -35,23 +35,14 @@ pub const MIRROR: f32 = 1.0;
 /// Share of the last step's pressure a solve starts from.
 const WARM: f32 = 0.5;
 
-/// Particles per parallel work item (fixed, so reductions do not depend on the number of threads).
-pub const CHUNK: usize = 256;
-
 /// Constants of the scheme in the precision of the loops.
 #[derive(Clone, Copy, Debug)]
 pub struct Coefficients {
-    pub h: f32,
-    pub support2: f32,
-    pub m_fluid: f32,
-    pub m_bound: f32,
+    /// The pair constants shared with the weakly-compressible scheme: h, support², masses, and the
+    /// artificial viscosity's c0, α (liquid and wall pairs) and η².
+    pub pair: super::wcsph::Coefficients,
     /// The density the solver holds: the summed density of a particle inside the initial lattice.
     pub rho_rest: f32,
-    /// Sound speed and α of the artificial viscosity (liquid pairs, wall pairs).
-    pub c0: f32,
-    pub alpha: f32,
-    pub alpha_bound: f32,
-    pub eta2: f32,
     /// Neighbours (liquid and wall) a particle needs for the divergence solver to act on it (fewer: it is
     /// at the free surface).
     pub full_neighbourhood: u32,
@@ -148,7 +139,7 @@ fn build_chunk<const D: usize, K: Kernel>(
         lists.bstart.push(lists.bj.len() as u32);
         let xa: [f32; D] = std::array::from_fn(|d| f.x[d][a]);
         let va: [f32; D] = std::array::from_fn(|d| f.v[d][a]);
-        let mut density = c.m_fluid * w0;
+        let mut density = c.pair.m_fluid * w0;
         // Σ m∇W over liquid and over wall neighbours.
         let mut grad = [0.0f32; D];
         let mut grad_b = [0.0f32; D];
@@ -157,8 +148,8 @@ fn build_chunk<const D: usize, K: Kernel>(
         let mut wall = [0.0f32; D];
         let mut moment = [0.0f32; 3];
         for (own, starts, xs, m, alpha) in [
-            (true, &f.starts, &f.x, c.m_fluid, c.alpha),
-            (false, &b.starts, &b.x, c.m_bound, c.alpha_bound),
+            (true, &f.starts, &f.x, c.pair.m_fluid, c.pair.alpha),
+            (false, &b.starts, &b.x, c.pair.m_bound, c.pair.alpha_bound),
         ] {
             let n = p.grid.ranges(f.cell[a], starts, &mut ranges);
             for &(lo, hi) in &ranges[..n] {
@@ -172,7 +163,7 @@ fn build_chunk<const D: usize, K: Kernel>(
                         dx[d] = xa[d] - xs[d][j];
                         r2 += dx[d] * dx[d];
                     }
-                    if r2 >= c.support2 {
+                    if r2 >= c.pair.support2 {
                         continue;
                     }
                     let r = r2.sqrt();
@@ -190,8 +181,8 @@ fn build_chunk<const D: usize, K: Kernel>(
                         vr += (va[d] - vb) * dx[d];
                     }
                     // Monaghan's artificial viscosity on approaching pairs, densities at ρ_rest.
-                    let mu = c.h * vr.min(0.0) / (r2 + c.eta2);
-                    let pi = -alpha * c.c0 * mu / c.rho_rest;
+                    let mu = c.pair.h * vr.min(0.0) / (r2 + c.pair.eta2);
+                    let pi = -alpha * c.pair.c0 * mu / c.rho_rest;
                     let mut pair = [0.0f32; D];
                     for d in 0..D {
                         pair[d] = -m * pi * g[d];
@@ -225,7 +216,7 @@ fn build_chunk<const D: usize, K: Kernel>(
             .max(0.0)
             + sq;
         rho[o] = density;
-        factor[o] = if denom > 1e-6 * c.m_fluid * c.m_fluid / (c.h * c.h) {
+        factor[o] = if denom > 1e-6 * c.pair.m_fluid * c.pair.m_fluid / (c.pair.h * c.pair.h) {
             1.0 / denom
         } else {
             0.0
@@ -245,8 +236,8 @@ fn build_chunk<const D: usize, K: Kernel>(
         out.max_speed = out.max_speed.max(v2.sqrt());
         let w3 = to3(wall);
         for d in 0..3 {
-            out.totals.force[d] += (w3[d] * c.m_fluid) as f64;
-            out.totals.moment[d] += (moment[d] * c.m_fluid) as f64;
+            out.totals.force[d] += (w3[d] * c.pair.m_fluid) as f64;
+            out.totals.moment[d] += (moment[d] * c.pair.m_fluid) as f64;
         }
     }
     lists.start.push(lists.j.len() as u32);
@@ -289,7 +280,7 @@ fn error_chunk<const D: usize>(
                 s += (va[d] - vb[d]) * g[d];
             }
         }
-        s *= c.m_fluid;
+        s *= c.pair.m_fluid;
         let (blo, bhi) = (lists.bstart[o] as usize, lists.bstart[o + 1] as usize);
         let mut sb = 0.0f32;
         for g in &lists.bg[blo..bhi] {
@@ -297,7 +288,7 @@ fn error_chunk<const D: usize>(
                 sb += va[d] * g[d];
             }
         }
-        s += c.m_bound * sb;
+        s += c.pair.m_bound * sb;
         let (e, kk) = match mode {
             Mode::Density => {
                 let e = (rho[o] + dt * s - c.rho_rest).max(0.0);
@@ -349,7 +340,7 @@ fn update_chunk<const D: usize>(
         let (blo, bhi) = (lists.bstart[o] as usize, lists.bstart[o + 1] as usize);
         for (b, g) in lists.bj[blo..bhi].iter().zip(&lists.bg[blo..bhi]) {
             // Pressure mirroring: the wall particle has the liquid particle's k.
-            let pair: [f32; D] = std::array::from_fn(|d| -MIRROR * c.m_bound * ka * g[d]);
+            let pair: [f32; D] = std::array::from_fn(|d| -MIRROR * c.pair.m_bound * ka * g[d]);
             let xb = to3(std::array::from_fn::<f32, D, _>(|d| {
                 bound.x[d][*b as usize]
             }));
@@ -362,12 +353,12 @@ fn update_chunk<const D: usize>(
             }
         }
         for d in 0..D {
-            vel[o][d] += dt * (c.m_fluid * acc[d] + wall[d]);
+            vel[o][d] += dt * (c.pair.m_fluid * acc[d] + wall[d]);
         }
         let w3 = to3(wall);
         for d in 0..3 {
-            tot.force[d] += (w3[d] * c.m_fluid) as f64;
-            tot.moment[d] += (moment[d] * c.m_fluid) as f64;
+            tot.force[d] += (w3[d] * c.pair.m_fluid) as f64;
+            tot.moment[d] += (moment[d] * c.pair.m_fluid) as f64;
         }
     }
     Partial {

@@ -5,6 +5,10 @@ pub mod candidates;
 pub mod dfsph;
 pub mod wcsph;
 
+/// Particles per parallel work item of every scheme's passes (fixed, so reductions do not depend on the
+/// number of threads).
+pub const CHUNK: usize = 256;
+
 /// The tank frame's motion as the particles feel it, in the tank frame (x, y, z).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameTerms {

@@ -6,16 +6,13 @@
 //! rates, so threads never share a write; chunks of fixed size make the sums independent of the thread count.
 
 use super::candidates::{Candidates, LANES};
-use super::{FrameTerms, PassTotals};
+use super::{FrameTerms, PassTotals, CHUNK};
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DiffusionKind;
 use crate::particles::{Boundary, Fluid};
 use crate::tank::{from3, to3};
 use rayon::prelude::*;
-
-/// Particles per parallel work item (fixed, so reductions do not depend on the number of threads).
-pub const CHUNK: usize = 256;
 
 /// Constants of the scheme in the precision of the loops.
 #[derive(Clone, Copy, Debug)]
