@@ -6,10 +6,14 @@
 
 pub mod bench;
 pub mod config;
+pub mod iox;
 pub mod motion_source;
 pub mod output;
+pub mod plot;
 pub mod record;
+pub mod render;
 pub mod replay;
 pub mod resolution;
 pub mod ros;
 pub mod runner;
+pub mod snapshot;

@@ -1,5 +1,6 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
+use slosh_node::snapshot::{SnapshotFrame, SnapshotOptions};
 use slosh_node::{bench, config, ros, runner};
 use std::path::PathBuf;
 
@@ -26,6 +27,8 @@ enum Command {
         /// Override a parameter by its dotted name, value as YAML: --set solver.cfl=0.15 --set probes.x=[-0.3,0.0]
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        #[command(flatten)]
+        visuals: Visuals,
     },
     /// Replay the vessel motion recorded in a rosbag2 MCAP bag through a case: the outputs of `slosh run`
     /// (CSV) and a new bag with the motion and every output.
@@ -53,6 +56,68 @@ enum Command {
         #[arg(long)]
         duration: Option<f64>,
         /// Override a parameter by its dotted name, value as YAML: --set replay.bad_samples=drop
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        #[command(flatten)]
+        visuals: Visuals,
+    },
+    /// Draw a run's outputs as PNG and SVG figures in DIR/plots: probe elevations (fill level marked), the
+    /// six wrench components, pressure sensors; --reference overlays measured or analytic data.
+    Plot {
+        /// The folder a `slosh run` or `slosh replay` wrote.
+        dir: PathBuf,
+        /// A CSV of a time column and columns named like the run's (probe names, fx..mz, sensor names) to
+        /// overlay; repeat for several.
+        #[arg(long = "reference", value_name = "FILE.csv")]
+        references: Vec<PathBuf>,
+        /// Image size in pixels.
+        #[arg(long, default_value = "1200x800")]
+        size: String,
+        /// Output folder (default: DIR/plots).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Turn a run's particle frames (`--snapshots`) into PNG pictures and an animated GIF in DIR/render.
+    Render {
+        /// The folder of a run made with --snapshots (or its snapshots folder).
+        dir: PathBuf,
+        /// Colour the liquid by speed or by pressure.
+        #[arg(long, value_enum, default_value_t = slosh_node::render::Colour::Speed)]
+        colour: slosh_node::render::Colour,
+        /// Picture size in pixels.
+        #[arg(long, default_value = "960x640")]
+        size: String,
+        /// GIF frames per second.
+        #[arg(long, default_value_t = 10.0)]
+        fps: f64,
+        /// 3D runs: draw the particles of the layer at y = SLICE (m, tank frame) instead of a side view.
+        #[arg(long)]
+        slice: Option<f64>,
+        /// Output folder (default: DIR/render).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Serve the case to a co-simulation over iceoryx2 (shared memory): each request is the vessel's state at
+    /// the sender's time t, each answer the liquid's wrench, probes and pressures at t.
+    Couple {
+        /// Config file or built-in case (its `motion.*` is not used).
+        config: String,
+        /// Service prefix: NAME/coupling, NAME/outputs, NAME/particles.
+        #[arg(long, default_value = "slosh")]
+        service: String,
+        /// Publish particle frames on NAME/particles at this many per second of sample time.
+        #[arg(long, default_value_t = 0.0)]
+        particles: f64,
+        /// Answer without simulating (to time the transport alone).
+        #[arg(long)]
+        dry: bool,
+        /// Also write probes.csv, wrench.csv and pressure.csv here.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Stop after this many answered steps (default: until SIGINT/SIGTERM).
+        #[arg(long)]
+        max_steps: Option<u64>,
+        /// Override a parameter by its dotted name, value as YAML.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
@@ -116,6 +181,47 @@ enum Command {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
+}
+
+/// Pictures and particle frames of a run.
+#[derive(clap::Args)]
+struct Visuals {
+    /// Write particle frames for ParaView at this many per simulated second: OUT/snapshots/run.pvd and
+    /// frame_NNNNNN.vtu (position, velocity, pressure, density, fluid flag, id).
+    #[arg(long, value_name = "HZ")]
+    snapshots: Option<f64>,
+    /// The frame of the particle frames: the tank's, or the world's (moved with the tank).
+    #[arg(long, value_enum, default_value_t = SnapshotFrame::Tank)]
+    snapshot_frame: SnapshotFrame,
+    /// Draw the figures of `slosh plot` into OUT/plots when the run ends.
+    #[arg(long)]
+    plot: bool,
+}
+
+impl Visuals {
+    fn snapshots(&self, out: &std::path::Path) -> Option<SnapshotOptions> {
+        self.snapshots.map(|rate_hz| SnapshotOptions {
+            rate_hz,
+            frame: self.snapshot_frame,
+            dir: out.join("snapshots"),
+        })
+    }
+
+    /// Draws the run's figures if asked to (also after a run that stopped early: the outputs so far).
+    fn plot_after<T>(&self, out: &std::path::Path, run: anyhow::Result<T>) -> anyhow::Result<T> {
+        if self.plot && out.join("probes.csv").exists() {
+            match slosh_node::plot::plot(out, &slosh_node::plot::PlotOptions::default()) {
+                Ok(p) => eprintln!(
+                    "slosh: figures in {}/plots ({} files)",
+                    out.display(),
+                    p.files.len()
+                ),
+                Err(e) if run.is_ok() => return Err(anyhow::anyhow!("plotting: {e}")),
+                Err(e) => eprintln!("slosh: plotting: {e}"),
+            }
+        }
+        run
+    }
 }
 
 #[derive(Subcommand)]
@@ -208,6 +314,7 @@ fn main() -> anyhow::Result<()> {
             out,
             duration,
             set,
+            visuals,
         } => {
             let loaded = config::load(&cfg, &set)?;
             eprintln!(
@@ -220,8 +327,10 @@ fn main() -> anyhow::Result<()> {
                 duration,
                 progress: true,
                 rate: None,
+                snapshots: visuals.snapshots(&out),
             };
-            let s = runner::run(&loaded, &out, &opts)?;
+            let s =
+                visuals.plot_after(&out, runner::run(&loaded, &out, &opts).map_err(Into::into))?;
             println!(
                 "done: {} s simulated in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s, {} liquid + {} boundary particles, {} lost)",
                 s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s, s.particles_fluid, s.particles_boundary, s.particles_lost
@@ -240,6 +349,7 @@ fn main() -> anyhow::Result<()> {
             out,
             duration,
             set,
+            visuals,
         } => {
             let loaded = config::load(&cfg, &set)?;
             let out = out.unwrap_or_else(|| beside(&bag, "_replay"));
@@ -248,8 +358,9 @@ fn main() -> anyhow::Result<()> {
                 duration,
                 rate,
                 progress: true,
+                snapshots: visuals.snapshots(&out),
             };
-            let s = slosh_node::replay::replay(&bag, &loaded, &out, &opts, |f| {
+            let s = visuals.plot_after(&out, slosh_node::replay::replay(&bag, &loaded, &out, &opts, |f| {
                 eprintln!(
                     "slosh: replaying {} ({}, {} of {} messages, {:.3} s, times from {}) through {}, writing to {} and the bag {}",
                     f.topic, f.type_name, f.samples, f.messages, f.span_s,
@@ -259,7 +370,7 @@ fn main() -> anyhow::Result<()> {
                 for d in &f.dropped {
                     eprintln!("slosh: dropped {d}");
                 }
-            })?;
+            }).map_err(Into::into))?;
             println!(
                 "done: {} s replayed in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s)",
                 s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s
@@ -268,6 +379,81 @@ fn main() -> anyhow::Result<()> {
                 "outputs: {}/{{probes.csv, wrench.csv, pressure.csv, summary.json}}",
                 out.display()
             );
+        }
+        Command::Couple {
+            config: cfg,
+            service,
+            particles,
+            dry,
+            out,
+            max_steps,
+            set,
+        } => {
+            let loaded = config::load(&cfg, &set)?;
+            let opts = slosh_node::iox::couple::CoupleOptions {
+                service: service.clone(),
+                particles_hz: particles,
+                dry,
+                out,
+                max_steps,
+            };
+            let s = slosh_node::iox::couple::serve(&loaded, &opts, || {
+                eprintln!(
+                    "slosh: serving {} on iceoryx2 service {service}/coupling (outputs on {service}/outputs{})",
+                    loaded.source_name,
+                    if particles > 0.0 { format!(", particles on {service}/particles") } else { String::new() }
+                );
+            })?;
+            println!("{}", serde_json::to_string(&s)?);
+        }
+        Command::Plot {
+            dir,
+            references,
+            size,
+            out,
+        } => {
+            let opts = slosh_node::plot::PlotOptions {
+                size: slosh_node::plot::parse_size(&size).map_err(anyhow::Error::msg)?,
+                references,
+                out,
+            };
+            let p = slosh_node::plot::plot(&dir, &opts).map_err(anyhow::Error::msg)?;
+            for u in &p.unmatched {
+                eprintln!("slosh: reference column left out (no run column of that name): {u}");
+            }
+            for f in &p.files {
+                println!("{}", f.display());
+            }
+        }
+        Command::Render {
+            dir,
+            colour,
+            size,
+            fps,
+            slice,
+            out,
+        } => {
+            let opts = slosh_node::render::RenderOptions {
+                colour,
+                size: slosh_node::plot::parse_size(&size).map_err(anyhow::Error::msg)?,
+                fps,
+                slice,
+                out,
+            };
+            let r = slosh_node::render::render(&dir, &opts).map_err(anyhow::Error::msg)?;
+            println!(
+                "{} frames: {} .. {}",
+                r.frames.len(),
+                r.frames
+                    .first()
+                    .map(|p| p.display().to_string())
+                    .unwrap_or_default(),
+                r.frames
+                    .last()
+                    .map(|p| p.display().to_string())
+                    .unwrap_or_default()
+            );
+            println!("{}", r.gif.display());
         }
         Command::Bench {
             case,

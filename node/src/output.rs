@@ -111,6 +111,9 @@ pub struct Summary {
     /// Where the motion came from, for runs not driven by the config's `motion.*` (e.g. `slosh replay`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub input: Option<serde_json::Value>,
+    /// Particle frames written (`--snapshots`): folder, series file, frames, rate and frame of reference.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub snapshots: Option<serde_json::Value>,
     pub parameters: serde_json::Value,
 }
 

@@ -5,6 +5,7 @@ use crate::config::Loaded;
 use crate::motion_source;
 use crate::output::{write_summary, CsvOutputs, Summary};
 use crate::record::{record_state, RecordCfg, RecordError, Recorder};
+use crate::snapshot::{SnapshotOptions, SnapshotWriter};
 use indicatif::{ProgressBar, ProgressStyle};
 use sph::motion::TankMotion;
 use sph::Solver;
@@ -42,6 +43,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// Simulated seconds per wall-clock second at most (None: as fast as possible).
     pub rate: Option<f64>,
+    /// Particle frames for ParaView (None: off).
+    pub snapshots: Option<SnapshotOptions>,
 }
 
 /// Records one observed state: the outputs and the motion that drove the tank up to it.
@@ -115,11 +118,28 @@ pub fn drive(
             .into());
         }
     }
+    if let Some(s) = &opts.snapshots {
+        if !(s.rate_hz.is_finite() && s.rate_hz > 0.0) {
+            return Err(crate::config::ConfigError::Key {
+                source_name: "--snapshots".into(),
+                key: "snapshots".into(),
+                message: format!(
+                    "must be a positive number of frames per simulated second, got {}",
+                    s.rate_hz
+                ),
+            }
+            .into());
+        }
+    }
     let mut record = match d.record {
         Some((rc, f)) => Some((Recorder::create(&rc, &cfg.parameters)?, f)),
         None => None,
     };
     let mut outputs = CsvOutputs::create(out, &params)?;
+    let mut snapshots = match &opts.snapshots {
+        Some(s) => Some((SnapshotWriter::create(s)?, s.rate_hz)),
+        None => None,
+    };
     let mut sim = sph::build(params.clone()).map_err(|e| RunError::Solver {
         error: e,
         time: 0.0,
@@ -131,8 +151,11 @@ pub fn drive(
     let result = run_loop(
         sim.as_mut(),
         motion,
-        &mut outputs,
-        record.as_mut().map(|(r, f)| (r, &mut **f)),
+        Sinks {
+            out: &mut outputs,
+            rec: record.as_mut().map(|(r, f)| (r, &mut **f)),
+            snap: snapshots.as_mut().map(|(w, hz)| (w, *hz)),
+        },
         &stop,
         Pace {
             duration,
@@ -147,7 +170,16 @@ pub fn drive(
     // failure is the one reported (a bag that failed to write usually fails to finish too).
     let flushed = outputs.flush();
     let finished = record.map_or(Ok(()), |(mut r, _)| r.finish());
+    let snapshot_info = snapshots.map(|(w, hz)| {
+        let (dir, frame) = (w.dir().to_path_buf(), w.frame());
+        (w.finish(), dir, frame, hz)
+    });
+    let frames_written = match &snapshot_info {
+        Some((Err(e), ..)) => Err(LoopError::Io(std::io::Error::other(e.to_string()))),
+        _ => Ok(()),
+    };
     let result = result
+        .and(frames_written)
         .and_then(|()| flushed.map_err(LoopError::Io))
         .and_then(|()| finished.map_err(LoopError::Record));
     let (stats, counts) = (sim.stats(), sim.counts());
@@ -170,6 +202,15 @@ pub fn drive(
         liquid_mass_kg: sim.liquid_mass(),
         error: result.as_ref().err().map(|e| e.to_string()),
         input: d.input,
+        snapshots: snapshot_info.map(|(frames, dir, frame, hz)| {
+            serde_json::json!({
+                "dir": dir,
+                "series": dir.join(crate::snapshot::SERIES),
+                "frames": frames.unwrap_or(0),
+                "rate_hz": hz,
+                "frame": frame,
+            })
+        }),
         pressure_solver: (params.solver.scheme == sph::params::Scheme::Dfsph).then(|| {
             serde_json::json!({
                 "iterations": stats.solver_iterations,
@@ -220,17 +261,29 @@ struct Pace {
     speed: Option<f64>,
 }
 
+/// Where the observed states go: the CSVs, the recording (with how a state is recorded) and the particle
+/// frames (with their rate).
+struct Sinks<'a, 'r> {
+    out: &'a mut CsvOutputs,
+    rec: Option<(&'a mut Recorder, &'a mut RecordState<'r>)>,
+    snap: Option<(&'a mut SnapshotWriter, f64)>,
+}
+
 fn run_loop(
     sim: &mut dyn Solver,
     motion: &dyn TankMotion,
-    out: &mut CsvOutputs,
-    mut rec: Option<(&mut Recorder, &mut RecordState<'_>)>,
+    sinks: Sinks<'_, '_>,
     stop: &std::sync::atomic::AtomicBool,
     pace: Pace,
     bar: &ProgressBar,
 ) -> Result<(), LoopError> {
     let (duration, rate) = (pace.duration, pace.output_rate);
-    let mut k = 0u64;
+    let Sinks {
+        out,
+        mut rec,
+        mut snap,
+    } = sinks;
+    let (mut k, mut j) = (0u64, 0u64);
     let start = Instant::now();
     let mut last_draw = Instant::now();
     let mut last_flush = Instant::now();
@@ -243,6 +296,13 @@ fn run_loop(
                 record(r, &o).map_err(LoopError::Record)?;
             }
             k = (t * rate + 1e-9).floor() as u64 + 1;
+        }
+        if let Some((w, hz)) = snap.as_mut() {
+            if t >= j as f64 / *hz - 1e-9 {
+                w.send(sim.snapshot(), motion.state(t))
+                    .map_err(LoopError::Io)?;
+                j = (t * *hz + 1e-9).floor() as u64 + 1;
+            }
         }
         if t >= duration - 1e-9 {
             return Ok(());

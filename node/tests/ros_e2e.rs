@@ -308,6 +308,24 @@ fn compare_with_run(kind: &str, domain_id: u16) {
         clouds.len()
     );
     assert_eq!(clouds[0][1][0], 400, "one point per liquid particle");
+    if kind == "odom" {
+        // The shipped Foxglove layout opens this recording: every topic it reads is there (under the
+        // node's namespace), its message paths give numbers and the cloud has the colour field.
+        let l = common::check_layout(&dir.join("bag"), "/ship1");
+        assert_eq!(l["missing"], serde_json::json!([]), "{l}");
+        let resolved = l["resolved"].as_object().unwrap();
+        for key in [
+            "/particles#speed",
+            "/diagnostics",
+            "/probes.elevations[1]",
+            "/wrench.wrench.force.x",
+            "/wrench.wrench.torque.y",
+            "/motion/odom.pose.pose.position.x",
+        ] {
+            assert!(resolved[key].as_f64().is_some(), "{key}: {l}");
+        }
+        assert_eq!(resolved["/particles#speed"], 400.0);
+    }
     let bag_w = bag["rosbags"]["/ship1/wrench"]["items"].as_array().unwrap();
     assert_eq!(
         bag_w.len(),

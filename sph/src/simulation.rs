@@ -12,6 +12,7 @@ use crate::kernel::Kernel;
 use crate::motion::TankMotion;
 use crate::neighbours::Grid;
 use crate::observe::probes::Shell;
+use crate::observe::snapshot::Snapshot;
 use crate::observe::{pressure, probes, wall_pressure, Observation, Wrench};
 use crate::params::{BoundaryMethod, Integrator, Scheme, SimParams};
 use crate::particles::{Boundary, Fluid, SortScratch};
@@ -582,6 +583,52 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             .collect()
     }
 
+    /// Every particle's position, velocity, pressure and density now, in the tank frame (changes nothing).
+    pub fn snapshot(&self) -> Snapshot {
+        let (f, b) = (&self.fluid, &self.bound);
+        let (nf, nb) = (f.len(), b.len());
+        let dfsph = self.params.solver.scheme == Scheme::Dfsph;
+        let mut s = Snapshot {
+            time: self.time,
+            dimension: D,
+            fluid: nf,
+            position: Vec::with_capacity(nf + nb),
+            velocity: Vec::with_capacity(nf + nb),
+            pressure: Vec::with_capacity(nf + nb),
+            density: Vec::with_capacity(nf + nb),
+            id: Vec::with_capacity(nf + nb),
+        };
+        for i in 0..nf {
+            s.position.push(to3(std::array::from_fn::<f32, D, _>(|k| {
+                f.pos[k][i] as f32
+            })));
+            s.velocity.push(to3(std::array::from_fn::<f32, D, _>(|k| {
+                f.vel[k][i] as f32
+            })));
+            let rho = f.rho[i] as f32;
+            s.pressure.push(if dfsph {
+                f.pressure[i] as f32
+            } else {
+                self.eos.pressure(rho)
+            });
+            s.density.push(rho);
+            s.id.push(f.id[i]);
+        }
+        for j in 0..nb {
+            s.position
+                .push(to3(std::array::from_fn::<f32, D, _>(|k| b.x[k][j])));
+            s.velocity
+                .push(to3(std::array::from_fn::<f32, D, _>(|k| b.v[k][j])));
+            let rho = b.rho.get(j).map_or(self.eos.rho0, |&r| r as f32);
+            s.pressure
+                .push(if dfsph { 0.0 } else { self.eos.pressure(rho) });
+            s.density
+                .push(if dfsph { self.dcoef.rho_rest } else { rho });
+            s.id.push(j as u32);
+        }
+        s
+    }
+
     /// Sets every liquid particle's velocity from its position (x, y, z in, x, y, z out): initial conditions.
     pub fn set_fluid_velocity(&mut self, f: &dyn Fn([f64; 3]) -> [f64; 3]) {
         for i in 0..self.fluid.len() {
@@ -649,6 +696,7 @@ pub trait Solver: Send {
     fn fluid_positions(&self) -> Vec<[f64; 3]>;
     fn fluid_velocities(&self) -> Vec<[f64; 3]>;
     fn set_fluid_velocity(&mut self, f: &dyn Fn([f64; 3]) -> [f64; 3]);
+    fn snapshot(&self) -> Snapshot;
 }
 
 impl<const D: usize, K: Kernel> Solver for Simulation<D, K> {
@@ -684,6 +732,9 @@ impl<const D: usize, K: Kernel> Solver for Simulation<D, K> {
     }
     fn set_fluid_velocity(&mut self, f: &dyn Fn([f64; 3]) -> [f64; 3]) {
         Simulation::set_fluid_velocity(self, f)
+    }
+    fn snapshot(&self) -> Snapshot {
+        Simulation::snapshot(self)
     }
 }
 

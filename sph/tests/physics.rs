@@ -608,3 +608,56 @@ fn dfsph_dam_break_front_follows_martin_and_moyce() {
 fn dfsph_accelerating_tank_tilts_the_surface_and_pushes_back() {
     check_accelerating(dfsph(tank2d(0.8, 0.6, 0.39, 0.02)));
 }
+
+/// A snapshot holds every particle (liquid first) with the hydrostatic pressure of a tank at rest, and
+/// taking one changes nothing: a run that snapshots every step stays bit-identical to one that does not.
+#[test]
+fn snapshots_hold_every_particle_with_hydrostatic_pressure_and_change_nothing() {
+    for scheme in [Scheme::Wcsph, Scheme::Dfsph] {
+        let mut p = tank2d(0.4, 0.3, 0.15, 0.01);
+        p.solver.scheme = scheme;
+        p.solver.boundary.method = BoundaryMethod::Dynamic;
+        let mut a = sph::build(p.clone()).unwrap();
+        let mut b = sph::build(p).unwrap();
+        a.advance_to(&AtRest, 0.2).unwrap();
+        while b.time() < a.time() - 1e-12 {
+            let _ = b.snapshot();
+            b.step(&AtRest).unwrap();
+        }
+        assert_eq!(a.fluid_positions(), b.fluid_positions(), "{scheme:?}");
+        assert_eq!(a.fluid_velocities(), b.fluid_velocities(), "{scheme:?}");
+        let s = b.snapshot();
+        let c = b.counts();
+        assert_eq!((s.fluid, s.len()), (c.fluid, c.fluid + c.boundary));
+        assert_eq!(s.time, b.time());
+        assert!(s.position[..s.fluid]
+            .iter()
+            .zip(b.fluid_positions())
+            .all(|(x, y)| (0..3).all(|k| x[k] == y[k] as f32)));
+        // Liquid pressure against ρ g (fill − z): particle by particle below the surface rows (the
+        // weakly-compressible scheme), and on average over the liquid (the incompressible scheme, whose
+        // per-particle pressures are the solver's multipliers: noisy, and high in the bottom row).
+        let bottom = 1000.0 * G * 0.15;
+        let (mut worst, mut sum, mut want_sum): (f64, f64, f64) = (0.0, 0.0, 0.0);
+        for i in 0..s.fluid {
+            let z = s.position[i][2] as f64;
+            let want = 1000.0 * G * (0.15 - z);
+            sum += s.pressure[i] as f64;
+            want_sum += want;
+            if z < 0.1 {
+                worst = worst.max((s.pressure[i] as f64 - want).abs() / bottom);
+            }
+        }
+        let mean = sum / want_sum;
+        if scheme == Scheme::Wcsph {
+            assert!(worst < 0.03, "pressure off by {worst:.3} of ρgH");
+        }
+        assert!(
+            (mean - 1.0).abs() < 0.15,
+            "{scheme:?}: mean pressure {mean:.3} of hydrostatic"
+        );
+        assert!(s.density[..s.fluid]
+            .iter()
+            .all(|r| (980.0..1020.0).contains(r)));
+    }
+}

@@ -43,6 +43,8 @@ pub struct ReplayOptions {
     /// Simulated seconds per wall-clock second at most (None: as fast as possible).
     pub rate: Option<f64>,
     pub progress: bool,
+    /// Particle frames for ParaView (None: off).
+    pub snapshots: Option<crate::snapshot::SnapshotOptions>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -146,6 +148,7 @@ pub fn replay(
         duration: Some(opts.duration.unwrap_or(span)),
         progress: opts.progress,
         rate: opts.rate,
+        snapshots: opts.snapshots.clone(),
     };
     let input = serde_json::to_value(&found).expect("serialises");
     Ok(drive(

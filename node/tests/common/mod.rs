@@ -114,6 +114,26 @@ pub fn read_bag(bag: &std::path::Path) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+/// The shipped Foxglove layout checked against a recorded bag (tests/py/check_layout.py, decoding with
+/// rosbags); `namespace` is where the node's relative topic names went (e.g. "/ship1", or "").
+pub fn check_layout(bag: &std::path::Path, namespace: &str) -> serde_json::Value {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let out = Command::new(python())
+        .arg(format!("{root}/tests/py/check_layout.py"))
+        .arg(format!("{root}/launch-configs/foxglove_layout.json"))
+        .arg(bag)
+        .arg(namespace)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "the layout does not fit the recording {}: {}",
+        bag.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 /// The `slosh` binary under test.
 pub fn slosh() -> Command {
     Command::new(env!("CARGO_BIN_EXE_slosh"))

@@ -2,10 +2,12 @@
 //! from the motion is the frame's acceleration relative to free fall and its rotation rate: positions in the
 //! world never enter the particle arithmetic (a tank kilometres from the origin behaves like one at it).
 
+mod coupled;
 mod irregular;
 mod regular;
 mod sampled;
 
+pub use coupled::CoupledMotion;
 pub use irregular::{IrregularMotion, JonswapDof};
 pub use regular::{RegularDof, RegularMotion};
 pub use sampled::{SampleError, SampledMotion};

@@ -3,6 +3,7 @@
 
 pub mod pressure;
 pub mod probes;
+pub mod snapshot;
 pub mod wall_pressure;
 
 use crate::kernel::Kernel;

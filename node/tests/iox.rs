@@ -1,0 +1,319 @@
+//! The iceoryx2 coupling server (`slosh couple`) end to end: against an offline run of the same motion, with
+//! refused samples, the shipped example client, particle frames, and a client killed mid-run. Each test has
+//! its own iceoryx2 prefix and root folder, and checks that nothing is left behind.
+
+mod common;
+
+use common::{slosh, tmp};
+use slosh_node::iox::client::CouplingClient;
+use slosh_node::iox::*;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const CASE: &str = "slosh:
+  ros__parameters:
+    dimension: 2
+    tank: {length: 0.8, breadth: 0.25, height: 0.6}
+    fill_height: 0.19
+    particle_spacing: 0.02
+    probes: {names: [left, mid], x: [-0.375, 0.0], y: [0.0, 0.0]}
+    pressure_sensors: {names: [wall_left], x: [-0.4], y: [0.0], z: [0.05]}
+    output_rate_hz: 20.0
+    duration: 1.0
+    motion:
+      source: regular
+      regular: {amplitude: [0.02, 0, 0, 0, 0.05, 0], period: [0.8, 0, 0, 0, 0.8, 0], phase: [0, 0, 0, 0, 0, 0]}
+";
+
+/// The iceoryx2 isolation of one test: its prefix and root folder, set in this process and its children.
+struct Iox {
+    prefix: String,
+    root: PathBuf,
+}
+
+impl Iox {
+    fn new(name: &str) -> Self {
+        let prefix = format!("slt{}{name}_", std::process::id());
+        let root = PathBuf::from(format!("/tmp/slt{}{name}/", std::process::id()));
+        // Every test of this binary sets the same variables before it starts anything: one at a time.
+        std::env::set_var("SLOSH_IOX_PREFIX", &prefix);
+        std::env::set_var("SLOSH_IOX_ROOT", &root);
+        Self { prefix, root }
+    }
+
+    /// Shared-memory files of this test's prefix.
+    fn shm(&self) -> Vec<String> {
+        std::fs::read_dir("/dev/shm")
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with(&self.prefix))
+            .collect()
+    }
+
+    /// Asserts that only iceoryx2's per-prefix management segment and empty folders are left, then
+    /// removes them.
+    fn assert_clean(&self) {
+        let left: Vec<String> = self
+            .shm()
+            .into_iter()
+            .filter(|n| !n.ends_with(".global_mgmt"))
+            .collect();
+        assert!(left.is_empty(), "left in /dev/shm: {left:?}");
+        let files: Vec<PathBuf> = walk(&self.root)
+            .into_iter()
+            .filter(|p| p.is_file())
+            .collect();
+        assert!(
+            files.is_empty(),
+            "left under {}: {files:?}",
+            self.root.display()
+        );
+        for n in self.shm() {
+            let _ = std::fs::remove_file(Path::new("/dev/shm").join(n));
+        }
+        let _ = std::fs::remove_dir_all(&self.root);
+    }
+}
+
+fn walk(p: &Path) -> Vec<PathBuf> {
+    let mut out = vec![];
+    if let Ok(d) = std::fs::read_dir(p) {
+        for e in d.flatten() {
+            out.push(e.path());
+            out.extend(walk(&e.path()));
+        }
+    }
+    out
+}
+
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// A server process, killed if the test fails before it is finished.
+struct Server(Option<Child>);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        if let Some(c) = self.0.as_mut() {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+fn server(case: &Path, extra: &[&str]) -> Server {
+    let c = slosh()
+        .arg("couple")
+        .arg(case)
+        .args(["--service", "t"])
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap();
+    // Ready once a client sees it serve.
+    let client = CouplingClient::connect("t", Duration::from_secs(10)).unwrap();
+    let s = Server(Some(c));
+    client.wait_for_server(Duration::from_secs(30)).unwrap();
+    s
+}
+
+fn finish(mut s: Server) -> serde_json::Value {
+    let o = s.0.take().unwrap().wait_with_output().unwrap();
+    assert!(o.status.success(), "slosh couple failed: {}", o.status);
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+fn csv(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+#[test]
+fn coupling_follows_an_offline_run_of_the_same_motion_and_refuses_bad_samples() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let iox = Iox::new("run");
+    let dir = tmp("iox-run");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, CASE).unwrap();
+    // The offline run, outputs every 0.05 s.
+    let o = slosh()
+        .arg("run")
+        .arg(&case)
+        .arg("--out")
+        .arg(dir.join("offline"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let offline = csv(&dir.join("offline/probes.csv"));
+    let offline_w = csv(&dir.join("offline/wrench.csv"));
+
+    let srv = server(&case, &["--max-steps", "21"]);
+    let client = CouplingClient::connect("t", Duration::from_secs(30)).unwrap();
+    let cfg = slosh_node::config::load(case.to_str().unwrap(), &[]).unwrap();
+    let motion = slosh_node::motion_source::build(&cfg).unwrap();
+    // The sender's clock starts at 100 s: the simulation's zero is the first sample.
+    let t0 = 100.0;
+    let mut got = vec![];
+    for k in 0..=20 {
+        let t = k as f64 * 0.05;
+        let s = sample_of(t0 + t, &motion.state(t));
+        let out = client.step(&s).unwrap();
+        assert_eq!(out.status, STATUS_OK, "{}", out.message());
+        assert_eq!(out.time, t0 + t);
+        assert_eq!((out.probe_count, out.pressure_count), (2, 1));
+        assert!(k == 0 || out.steps > 0, "no solver step for t = {t}");
+        got.push(out);
+        if k == 10 {
+            // Refused samples change nothing and name the field.
+            let mut bad = sample_of(t0 + t + 0.01, &motion.state(t));
+            bad.acceleration[2] = f64::NAN;
+            let r = client.step(&bad).unwrap();
+            assert_eq!(r.status, STATUS_REJECTED);
+            assert!(r.message().starts_with("acceleration"), "{}", r.message());
+            let r = client.step(&sample_of(t0 + t, &motion.state(t))).unwrap();
+            assert_eq!(r.status, STATUS_REJECTED);
+            assert!(
+                r.message().starts_with("time") && r.message().contains("not after"),
+                "{}",
+                r.message()
+            );
+        }
+    }
+    let summary = finish(srv);
+    assert_eq!(summary["steps_answered"], 21);
+    assert_eq!(summary["samples_rejected"], 2);
+    // Same liquid as the offline run: the tank follows the exact motion there and the Hermite path through
+    // the 20 Hz states here.
+    let mut worst = 0.0f64;
+    let (mut d2, mut n2) = (0.0, 0.0);
+    // Up to 0.9 s: the run-up at the left wall that peaks after it is sensitive to the path between samples.
+    for (k, out) in got.iter().enumerate().take(19) {
+        for (i, p) in out.probes().iter().enumerate() {
+            worst = worst.max((p - offline[k][1 + i]).abs());
+        }
+        d2 += (out.force[0] - offline_w[k][1]).powi(2);
+        n2 += offline_w[k][1].powi(2);
+    }
+    let rel = (d2 / n2).sqrt();
+    eprintln!(
+        "coupled vs offline: probes within {worst:.4} m, fx {:.1} % rms",
+        100.0 * rel
+    );
+    assert!(worst < 0.005, "probes differ by {worst} m");
+    assert!(rel < 0.1, "fx differs by {:.1} % rms", 100.0 * rel);
+    drop(client);
+    iox.assert_clean();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_example_client_couples_particles_flow_and_a_killed_client_disturbs_nothing() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let iox = Iox::new("ex");
+    let dir = tmp("iox-ex");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, CASE).unwrap();
+    let srv = server(&case, &["--particles", "20"]);
+
+    // Particle frames, read zero-copy.
+    let node = node("test_viewer").unwrap();
+    let sub = node
+        .service_builder(&"t/particles".try_into().unwrap())
+        .publish_subscribe::<[Particle]>()
+        .user_header::<ParticleHeader>()
+        .subscriber_max_buffer_size(2)
+        .open_or_create()
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap();
+
+    // The shipped example: a barge on a spring, 20 coupled steps of 10 ms.
+    let example = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .join("examples/couple");
+    let o = Command::new(&example)
+        .args(["--service", "t", "--steps", "20"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 21);
+    let last = &lines[20];
+    assert!((last["t"].as_f64().unwrap() - 0.2).abs() < 1e-9);
+    assert!(last["x"].as_f64().unwrap() != 0.0, "the barge did not move");
+    assert!(last["fx"].as_f64().unwrap().is_finite());
+    assert_eq!(last["probes"].as_array().unwrap().len(), 2);
+
+    let frame = {
+        let end = Instant::now() + Duration::from_secs(10);
+        loop {
+            if let Some(s) = sub.receive().unwrap() {
+                break (*s.user_header(), s.payload().len(), s.payload()[0]);
+            }
+            assert!(Instant::now() < end, "no particle frame");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    };
+    let (header, len, first) = frame;
+    assert_eq!(
+        header.fluid, 400,
+        "2D, 0.8 m x 0.19 m at 20 mm: 40 x 10 liquid particles"
+    );
+    assert!(len as u64 > header.fluid && header.dimension == 2);
+    assert!(first.position[0].abs() < 0.4 && first.density > 900.0);
+    drop(sub);
+    drop(node);
+
+    // A client killed mid-run (SIGKILL, between or inside steps): the server goes on for the next one.
+    let mut victim = Command::new(&example)
+        .args(["--service", "t", "--steps", "100000", "--start", "0.3"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(700));
+    victim.kill().unwrap();
+    let out = victim.wait_with_output().unwrap();
+    let t_last = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter_map(|v| v["t"].as_f64())
+        .fold(0.0, f64::max);
+    assert!(t_last > 0.3, "the killed client made no step");
+    let client = CouplingClient::connect("t", Duration::from_secs(30)).unwrap();
+    let cfg = slosh_node::config::load(case.to_str().unwrap(), &[]).unwrap();
+    let motion = slosh_node::motion_source::build(&cfg).unwrap();
+    for k in 1..=3 {
+        let t = t_last + 0.1 + 0.01 * k as f64;
+        let r = client.step(&sample_of(t, &motion.state(0.0))).unwrap();
+        assert_eq!(r.status, STATUS_OK, "after the kill: {}", r.message());
+    }
+    drop(client);
+    // SIGTERM stops the server cleanly, with its summary.
+    let pid = srv.0.as_ref().unwrap().id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let summary = finish(srv);
+    assert!(summary["steps_answered"].as_u64().unwrap() >= 21 + 3);
+    assert!(summary["particle_frames"].as_u64().unwrap() >= 1);
+    // The killed client's resources were cleaned up by the server (it cleans up dead nodes every second)
+    // or at its exit.
+    iox.assert_clean();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
