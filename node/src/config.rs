@@ -203,6 +203,36 @@ pub struct RunConfig {
     /// Diagnostics messages per wall-clock second (`slosh node`).
     #[serde(default = "default_diag_rate")]
     pub diagnostics_rate_hz: f64,
+    /// iceoryx2 services of `slosh node` beside (or instead of) DDS.
+    #[serde(default)]
+    pub iceoryx2: Iceoryx2Cfg,
+}
+
+/// The node's zero-copy services (see `crate::iox`): motion in with `input.type: iceoryx2`, outputs and
+/// particle frames out.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Iceoryx2Cfg {
+    /// Service prefix: `NAME/motion`, `NAME/outputs`, `NAME/particles`.
+    pub service: String,
+    /// Publish every output (wrench, probes, pressures) on `NAME/outputs`.
+    pub outputs: bool,
+    /// Publish every particle (liquid and walls) on `NAME/particles` at `particles.rate_hz`.
+    pub particles: bool,
+    /// Also publish the outputs and particle clouds over DDS (false: over iceoryx2 only; diagnostics,
+    /// `/tf_static`, `/clock`, services and the recording stay).
+    pub dds_outputs: bool,
+}
+
+impl Default for Iceoryx2Cfg {
+    fn default() -> Self {
+        Self {
+            service: "slosh".into(),
+            outputs: false,
+            particles: false,
+            dds_outputs: true,
+        }
+    }
 }
 
 fn default_timeout() -> f64 {
@@ -253,6 +283,9 @@ pub enum InputType {
     /// sensor_msgs/Imu on `motion/imu`: orientation, angular velocity and specific force of the vessel at
     /// its frame origin (the tank's offset adds the lever-arm terms).
     Imu,
+    /// `slosh::MotionSample` on the iceoryx2 service `<iceoryx2.service>/motion`: the vessel's full state
+    /// (z-up world, FLU vessel frame), recorded as Odometry + AccelStamped.
+    Iceoryx2,
 }
 
 /// Motion input of the ROS 2 node.

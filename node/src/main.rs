@@ -177,6 +177,13 @@ enum Command {
         /// Stamp of the first sample in seconds since the epoch (default: now).
         #[arg(long)]
         start_stamp: Option<f64>,
+        /// Publish `slosh::MotionSample`s on the iceoryx2 service NAME/motion instead of DDS (for a node
+        /// with `input.type: iceoryx2`).
+        #[arg(long, value_name = "NAME")]
+        iceoryx2: Option<String>,
+        /// Parameter overrides of the case, KEY=VALUE (with --iceoryx2; over DDS use --ros-args -p).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
         /// ROS arguments (`--ros-args -r __ns:=/ship1 ...`).
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
@@ -288,26 +295,33 @@ fn main() -> anyhow::Result<()> {
             wait_for_subscribers,
             lockstep,
             start_stamp,
+            iceoryx2,
+            set,
             args,
         } => {
             let (plain, ros_args) = ros::args::parse(&args)?;
             if !plain.is_empty() {
                 anyhow::bail!("unexpected arguments {plain:?}: ROS arguments go after --ros-args");
             }
-            ros::motion_pub::run(
-                &ros_args,
-                &cfg,
-                &ros::motion_pub::MotionOptions {
-                    rate_hz: rate,
-                    duration,
-                    pose,
-                    imu,
-                    accel,
-                    wait_for_subscribers,
-                    lockstep,
-                    start_stamp,
-                },
-            )?;
+            let opts = ros::motion_pub::MotionOptions {
+                rate_hz: rate,
+                duration,
+                pose,
+                imu,
+                accel,
+                wait_for_subscribers,
+                lockstep,
+                start_stamp,
+            };
+            match iceoryx2 {
+                Some(service) => slosh_node::iox::motion_pub::run(&cfg, &set, &service, &opts)?,
+                None => {
+                    if !set.is_empty() {
+                        anyhow::bail!("--set goes with --iceoryx2; over DDS give parameters as --ros-args -p KEY:=VALUE");
+                    }
+                    ros::motion_pub::run(&ros_args, &cfg, &opts)?
+                }
+            }
         }
         Command::Run {
             config: cfg,

@@ -1,6 +1,7 @@
-//! The iceoryx2 coupling server (`slosh couple`) end to end: against an offline run of the same motion, with
-//! refused samples, the shipped example client, particle frames, and a client killed mid-run. Each test has
-//! its own iceoryx2 prefix and root folder, and checks that nothing is left behind.
+//! The iceoryx2 transport end to end: the coupling server (`slosh couple`) against an offline run of the same
+//! motion, with refused samples, the shipped example client, particle frames, and a client killed mid-run;
+//! and the ROS 2 node driven and read over iceoryx2 only. Each test has its own iceoryx2 prefix and root
+//! folder, and checks that nothing is left behind.
 
 mod common;
 
@@ -223,12 +224,7 @@ fn the_example_client_couples_particles_flow_and_a_killed_client_disturbs_nothin
 
     // Particle frames, read zero-copy.
     let node = node("test_viewer").unwrap();
-    let sub = node
-        .service_builder(&"t/particles".try_into().unwrap())
-        .publish_subscribe::<[Particle]>()
-        .user_header::<ParticleHeader>()
-        .subscriber_max_buffer_size(2)
-        .open_or_create()
+    let sub = particles_service(&node, "t")
         .unwrap()
         .subscriber_builder()
         .create()
@@ -314,6 +310,190 @@ fn the_example_client_couples_particles_flow_and_a_killed_client_disturbs_nothin
     assert!(summary["particle_frames"].as_u64().unwrap() >= 1);
     // The killed client's resources were cleaned up by the server (it cleans up dead nodes every second)
     // or at its exit.
+    iox.assert_clean();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_node_takes_motion_and_gives_outputs_and_particles_over_iceoryx2_like_slosh_run() {
+    // The node still starts a DDS participant (diagnostics, services): loopback only.
+    if !common::in_private_netns(
+        "the_node_takes_motion_and_gives_outputs_and_particles_over_iceoryx2_like_slosh_run",
+    ) {
+        return;
+    }
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let iox = Iox::new("node");
+    let dir = tmp("iox-node");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, CASE).unwrap();
+    let node_cmd = |extra: &[&str]| {
+        let mut c = slosh();
+        c.args(["node", "--duration", "1.0", "--ros-args", "--params-file"])
+            .arg(&case)
+            .args([
+                "-p",
+                "input.type:=iceoryx2",
+                "-p",
+                "iceoryx2.service:=tank1",
+            ])
+            .args(extra)
+            .env("ROS_DOMAIN_ID", "61");
+        c
+    };
+    // Misconfigurations are refused by name.
+    let o = node_cmd(&["-p", "iceoryx2.particles:=true"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("particles.rate_hz"), "{err}");
+    let o = node_cmd(&["-p", "iceoryx2.dds_outputs:=false"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("iceoryx2.outputs"), "{err}");
+
+    // The reader first, so it sees every output.
+    let viewer = node("test_viewer").unwrap();
+    let outs = outputs_service(&viewer, "tank1")
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap();
+    let parts = particles_service(&viewer, "tank1")
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap();
+    let bag = dir.join("bag");
+    let mut node_proc = Server(Some(
+        node_cmd(&[
+            "-p",
+            "iceoryx2.outputs:=true",
+            "-p",
+            "iceoryx2.particles:=true",
+            "-p",
+            "iceoryx2.dds_outputs:=false",
+            "-p",
+            "particles.rate_hz:=5.0",
+            "-p",
+            "realtime.mode:=lockstep",
+            "-p",
+            &format!("record.path:={}", bag.display()),
+        ])
+        .spawn()
+        .unwrap(),
+    ));
+    let t0 = 1000.0;
+    let motion_proc = Server(Some(
+        slosh()
+            .arg("motion")
+            .arg(&case)
+            .args(["--rate", "50", "--duration", "1.5", "--iceoryx2", "tank1"])
+            .args(["--wait-for-subscribers", "1", "--start-stamp", "1000"])
+            .spawn()
+            .unwrap(),
+    ));
+    let (mut got, mut frames) = (vec![], vec![]);
+    let end = Instant::now() + Duration::from_secs(120);
+    let mut exited = None;
+    while Instant::now() < end {
+        while let Some(s) = outs.receive().unwrap() {
+            got.push(*s.payload());
+        }
+        while let Some(s) = parts.receive().unwrap() {
+            let p = s.payload();
+            let fluid = s.user_header().fluid as usize;
+            let inside = p[..fluid]
+                .iter()
+                .all(|q| q.position[0].abs() < 0.4 && q.position[2] > 0.0 && q.density > 900.0);
+            frames.push((*s.user_header(), p.len(), inside));
+        }
+        if exited.is_none() {
+            exited = node_proc.0.as_mut().unwrap().try_wait().unwrap();
+        } else {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let status = exited.expect("slosh node did not finish within 120 s");
+    assert!(status.success(), "slosh node failed: {status}");
+    node_proc.0 = None;
+    drop(motion_proc);
+    while let Some(s) = outs.receive().unwrap() {
+        got.push(*s.payload());
+    }
+
+    // The same case offline, the motion known exactly; both observe at the first step at or after k / 20 s.
+    let o = slosh()
+        .arg("run")
+        .arg(&case)
+        .arg("--out")
+        .arg(dir.join("offline"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let offline = csv(&dir.join("offline/probes.csv"));
+    let offline_w = csv(&dir.join("offline/wrench.csv"));
+    assert!(
+        got.len() + 2 >= offline.len(),
+        "{} outputs received",
+        got.len()
+    );
+    let (mut worst, mut d2, mut n2, mut compared) = (0.0f64, 0.0, 0.0, 0);
+    for out in &got {
+        assert_eq!(
+            (out.status, out.probe_count, out.pressure_count),
+            (STATUS_OK, 2, 1)
+        );
+        let t = out.time - t0;
+        let Some(k) = offline.iter().position(|r| (r[0] - t).abs() < 2e-3) else {
+            continue;
+        };
+        compared += 1;
+        for (i, p) in out.probes().iter().enumerate() {
+            worst = worst.max((p - offline[k][1 + i]).abs());
+        }
+        d2 += (out.force[0] - offline_w[k][1]).powi(2);
+        n2 += offline_w[k][1].powi(2);
+    }
+    let rel = (d2 / n2).sqrt();
+    eprintln!(
+        "node over iceoryx2 vs offline: {compared} outputs, probes within {worst:.4} m, fx {:.1} % rms",
+        100.0 * rel
+    );
+    assert!(
+        compared + 2 >= offline.len(),
+        "only {compared} at matching times"
+    );
+    assert!(worst < 0.01, "probes differ by {worst} m");
+    assert!(rel < 0.1, "fx differs by {:.1} % rms", 100.0 * rel);
+    // Particle frames: 5 per simulated second, every particle, the liquid in the tank.
+    assert!(frames.len() >= 4, "{} particle frames", frames.len());
+    for (h, len, inside) in &frames {
+        assert_eq!((h.fluid, h.dimension), (400, 2));
+        assert!(
+            *len > 400 && *inside,
+            "{h:?}: {len} particles, inside {inside}"
+        );
+    }
+
+    // The recording holds the iceoryx2 motion as Odometry + AccelStamped and the outputs (though no DDS
+    // output was published), read by rosbags and mcap.
+    let b = common::read_bag(&bag);
+    let items = |t: &str| b["rosbags"][t]["items"].as_array().map_or(0, Vec::len);
+    assert!(
+        items("/motion/odom") >= 50 && items("/motion/accel") >= 50,
+        "{b}"
+    );
+    assert_eq!(items("/wrench"), got.len());
+    assert!(items("/particles") >= 4);
+
+    drop(outs);
+    drop(parts);
+    drop(viewer);
     iox.assert_clean();
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -43,35 +43,14 @@ pub struct Served {
     pub last_time: Option<f64>,
 }
 
-fn outputs_of(time: f64, o: &Observation) -> StepOutputs {
-    let mut s = StepOutputs {
-        time,
-        force: o.wrench.force,
-        moment: o.wrench.moment,
-        probe_count: o.probes.len().min(MAX_SENSORS) as u32,
-        pressure_count: o.pressures.len().min(MAX_SENSORS) as u32,
-        ..Default::default()
-    };
-    s.probes[..s.probe_count as usize].copy_from_slice(&o.probes[..s.probe_count as usize]);
-    s.pressures[..s.pressure_count as usize]
-        .copy_from_slice(&o.pressures[..s.pressure_count as usize]);
-    s
-}
-
 /// Serves the case until stopped; `ready` is called once the services are up.
 pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow::Result<Served> {
     let params = cfg.sim_params()?;
-    for (what, n) in [
-        ("probes", params.probes.len()),
-        ("pressure_sensors", params.pressure_sensors.len()),
-    ] {
-        if n > MAX_SENSORS {
-            anyhow::bail!(
-                "{}: {what}: {n} configured, the iceoryx2 outputs carry at most {MAX_SENSORS}",
-                cfg.source_name
-            );
-        }
-    }
+    check_sensors(
+        &cfg.source_name,
+        params.probes.len(),
+        params.pressure_sensors.len(),
+    )?;
     if !(opts.particles_hz.is_finite() && opts.particles_hz >= 0.0) {
         anyhow::bail!(
             "--particles {}: frames per second of sample time, 0 or more",
@@ -94,30 +73,12 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
     let server: CouplingServer = svc.rr.server_builder().create()?;
     let listener = svc.request.listener_builder().create()?;
     let notifier = svc.response.notifier_builder().create()?;
-    let outputs = node
-        .service_builder(&service_name(&format!("{}/outputs", opts.service))?)
-        .publish_subscribe::<StepOutputs>()
-        .history_size(1)
-        .subscriber_max_buffer_size(64)
-        .open_or_create()?
-        .publisher_builder()
-        .create()?;
     let total = sim.counts().fluid + sim.counts().boundary;
-    let particles = if opts.particles_hz > 0.0 {
-        Some(
-            node.service_builder(&service_name(&format!("{}/particles", opts.service))?)
-                .publish_subscribe::<[Particle]>()
-                .user_header::<ParticleHeader>()
-                .subscriber_max_buffer_size(2)
-                .open_or_create()?
-                .publisher_builder()
-                .initial_max_slice_len(total.max(1))
-                .allocation_strategy(AllocationStrategy::PowerOfTwo)
-                .create()?,
-        )
-    } else {
-        None
-    };
+    let mut ports = OutputPorts::new(
+        &node,
+        &opts.service,
+        (opts.particles_hz > 0.0).then_some(total),
+    )?;
     let stop = crate::ros::shutdown_flag().map_err(std::io::Error::other)?;
     ready();
 
@@ -169,8 +130,8 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
             let _ = req.send_copy(answer);
             let _ = notifier.notify();
             if answer.status == STATUS_OK {
-                if let Err(e) = outputs.send_copy(answer) {
-                    break 'serve Err(anyhow::anyhow!("publishing the outputs: {e}"));
+                if let Err(e) = ports.publish(&answer) {
+                    break 'serve Err(e);
                 }
                 if let (Some(c), Some((t0, _))) = (csv.as_mut(), motion.as_ref()) {
                     let mut o = Observation {
@@ -185,30 +146,12 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
                         break 'serve Err(e.into());
                     }
                 }
-                if let (Some(p), Some((t0, _))) = (particles.as_ref(), motion.as_ref()) {
+                if let (true, Some((t0, _))) = (opts.particles_hz > 0.0, motion.as_ref()) {
                     if s.time - t0 >= next_frame as f64 / opts.particles_hz - 1e-9 {
-                        let snap = sim.snapshot();
-                        let sent = p.loan_slice_uninit(snap.len()).map(|mut sample| {
-                            *sample.user_header_mut() = ParticleHeader {
-                                time: s.time,
-                                fluid: snap.fluid as u64,
-                                dimension: snap.dimension as u32,
-                                reserved: 0,
-                            };
-                            sample.write_from_fn(|i| Particle {
-                                position: snap.position[i],
-                                velocity: snap.velocity[i],
-                                pressure: snap.pressure[i],
-                                density: snap.density[i],
-                            })
-                        });
-                        match sent.map(|s| s.send()) {
-                            Ok(Ok(_)) => served.particle_frames += 1,
-                            Ok(Err(e)) => {
-                                break 'serve Err(anyhow::anyhow!("publishing particles: {e}"))
-                            }
-                            Err(e) => break 'serve Err(anyhow::anyhow!("loaning particles: {e}")),
+                        if let Err(e) = ports.publish_particles(s.time, &sim.snapshot()) {
+                            break 'serve Err(e);
                         }
+                        served.particle_frames = ports.frames;
                         next_frame = ((s.time - t0) * opts.particles_hz + 1e-9).floor() as u64 + 1;
                     }
                 }

@@ -17,12 +17,15 @@
 
 pub mod client;
 pub mod couple;
+pub mod motion_pub;
+pub mod ports;
 pub mod types;
 
 use iceoryx2::node::Node;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+pub use ports::*;
 use sph::motion::RigidState;
 pub use types::*;
 

@@ -370,6 +370,7 @@ fn build(
                 })
             }
             R::Imu(m) => imu.push(t, imu_sample(m, how.frames)),
+            R::State(_) => unreachable!("bags are decoded to poses or IMU readings"),
         };
         match accepted {
             Ok(()) => messages.push((time_ns(d), f.messages[i].1.clone())),

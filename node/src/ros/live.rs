@@ -6,6 +6,7 @@ use super::convert::{position, unit, vector};
 use super::frames::Frames;
 use super::live_imu::{ImuSample, LiveImu};
 use super::live_motion::{Limits, LiveMotion, Rejected};
+use super::live_state::LiveState;
 use nalgebra::{UnitQuaternion, Vector3};
 use slosh_msgs::geometry_msgs::{Pose, Vector3 as Vec3Msg};
 use slosh_msgs::sensor_msgs::Imu;
@@ -16,6 +17,8 @@ use sph::motion::{RigidState, TankMotion};
 pub enum Reading {
     Pose(Pose),
     Imu(Box<Imu>),
+    /// The vessel's full state from iceoryx2 (z-up world, FLU vessel frame).
+    State(crate::iox::MotionSample),
 }
 
 /// The tank's six coordinates (x, y, z, roll, pitch, yaw) from a received vessel pose.
@@ -37,6 +40,7 @@ pub fn imu_sample(i: &Imu, frames: &Frames) -> ImuSample {
 pub enum Live {
     Pose(LiveMotion, Accel),
     Imu(LiveImu),
+    State(LiveState, crate::iox::Mount),
 }
 
 /// Measured accelerations of the vessel (geometry_msgs/AccelStamped on `motion/accel`, body frame), used
@@ -76,6 +80,16 @@ impl Accel {
 }
 
 impl Live {
+    /// Empty input of full states (iceoryx2 [`crate::iox::MotionSample`]s) for a tank mounted as `frames`
+    /// says.
+    pub fn states(limits: Limits, frames: &Frames) -> Self {
+        let (offset, rotation) = frames.mount();
+        Live::State(
+            LiveState::new(limits),
+            crate::iox::Mount { offset, rotation },
+        )
+    }
+
     /// Empty input of the kind `imu` says, for a tank mounted as `frames` says.
     pub fn new(imu: bool, limits: Limits, frames: &Frames, gravity: f64) -> Self {
         let (lever, mount) = frames.mount();
@@ -128,6 +142,10 @@ impl Live {
         match (self, r) {
             (Live::Pose(m, _), Reading::Pose(p)) => m.push(t, tank_coordinates(p, frames)),
             (Live::Imu(m), Reading::Imu(i)) => m.push(t, imu_sample(i, frames)),
+            (Live::State(m, mount), Reading::State(s)) => {
+                crate::iox::check(s).map_err(Rejected::Invalid)?;
+                m.push(t, crate::iox::tank_state(s, mount))
+            }
             _ => unreachable!("the input's kind is fixed at start-up"),
         }
     }
@@ -137,6 +155,7 @@ impl Live {
         match self {
             Live::Pose(m, _) => m.last_pose().is_some_and(|p| m.push(t, p).is_ok()),
             Live::Imu(m) => m.held().is_some_and(|s| m.push(t, s).is_ok()),
+            Live::State(m, _) => m.held().is_some_and(|s| m.push(t, s).is_ok()),
         }
     }
 
@@ -150,6 +169,7 @@ impl Live {
                 }
             }
             Live::Imu(m) => m.forget_before(t),
+            Live::State(m, _) => m.forget_before(t),
         }
     }
 
@@ -157,6 +177,7 @@ impl Live {
         match self {
             Live::Pose(m, _) => m.newest(),
             Live::Imu(m) => m.newest(),
+            Live::State(m, _) => m.newest(),
         }
     }
 
@@ -164,6 +185,7 @@ impl Live {
         match self {
             Live::Pose(m, _) => m.safe_until(delay_samples),
             Live::Imu(m) => m.safe_until(delay_samples),
+            Live::State(m, _) => m.safe_until(),
         }
     }
 }
@@ -173,6 +195,7 @@ impl TankMotion for Live {
         match self {
             Live::Pose(m, acc) => acc.apply(t, m.state(t)),
             Live::Imu(m) => m.state(t),
+            Live::State(m, _) => m.state(t),
         }
     }
 

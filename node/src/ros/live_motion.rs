@@ -19,6 +19,8 @@ pub enum Rejected {
     OutOfOrder { time: f64, newest: f64 },
     #[error("stamp {time:.6} s repeats the newest sample's (duplicate)")]
     Duplicate { time: f64 },
+    #[error("{0}")]
+    Invalid(String),
     #[error("{what} jumps by {size:.3} in {dt:.4} s, faster than the limit {limit} (input.max_speed / input.max_rotation_rate)")]
     Jump {
         what: &'static str,

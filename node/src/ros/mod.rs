@@ -8,6 +8,7 @@ pub mod frames;
 pub mod live;
 pub mod live_imu;
 pub mod live_motion;
+pub mod live_state;
 pub mod motion_pub;
 pub mod node;
 pub mod pacing;

@@ -179,6 +179,17 @@ enum Input {
     Odom(ros2_client::Subscription<Odometry>),
     Pose(ros2_client::Subscription<PoseStamped>),
     Imu(ros2_client::Subscription<Imu>),
+    /// iceoryx2 `NAME/motion`, recorded as Odometry on `motion/odom` and AccelStamped on (the resolved)
+    /// `.1`, with the vessel frame `.2`.
+    Iox(
+        iceoryx2::port::subscriber::Subscriber<
+            iceoryx2::prelude::ipc::Service,
+            crate::iox::MotionSample,
+            (),
+        >,
+        String,
+        String,
+    ),
 }
 
 impl Input {
@@ -188,6 +199,8 @@ impl Input {
             InputType::Odom => "motion/odom",
             InputType::Pose => "motion/pose",
             InputType::Imu => "motion/imu",
+            // Recorded there, as the Odometry it would be on DDS.
+            InputType::Iceoryx2 => "motion/odom",
         }
     }
 
@@ -223,6 +236,34 @@ impl Input {
                 Some((m, _)) => {
                     keep(rec, m.header.stamp, &m)?;
                     Some((m.header.stamp, Reading::Imu(Box::new(m))))
+                }
+                None => None,
+            },
+            Input::Iox(sub, accel_topic, vessel) => match sub
+                .receive()
+                .map_err(|e| anyhow::anyhow!("reading the iceoryx2 motion: {e}"))?
+            {
+                Some(sample) => {
+                    let m: crate::iox::MotionSample = *sample.payload();
+                    let stamp = Time::from_secs_f64(m.time);
+                    if let Some((r, topic)) = rec {
+                        let identity = crate::iox::Mount {
+                            offset: Default::default(),
+                            rotation: UnitQuaternion::identity(),
+                        };
+                        let v = crate::iox::tank_state(&m, &identity);
+                        r.write(
+                            topic,
+                            stamp,
+                            &super::motion_pub::odometry(&v, stamp, "odom", vessel),
+                        )?;
+                        r.write(
+                            accel_topic,
+                            stamp,
+                            &super::motion_pub::accel(&v, stamp, vessel),
+                        )?;
+                    }
+                    Some((stamp, Reading::State(m)))
                 }
                 None => None,
             },
@@ -273,7 +314,44 @@ pub fn run(
         .map_err(|e| anyhow::anyhow!("cannot create the node: {e:?}"))?;
 
     let topic = Input::topic(c.input.kind);
+    let iox = &c.iceoryx2;
+    let iox_on = c.input.kind == InputType::Iceoryx2 || iox.outputs || iox.particles;
+    if c.input.kind == InputType::Iceoryx2
+        && (c.input.world_frame != super::frames::WorldFrame::Enu
+            || c.input.body_frame != super::frames::BodyFrame::Flu)
+    {
+        anyhow::bail!(
+            "{}: input.world_frame / input.body_frame: iceoryx2 motion samples are always in a z-up world and the FLU vessel frame; leave both at enu / flu",
+            cfg.source_name
+        );
+    }
+    if iox_on {
+        crate::iox::check_sensors(
+            &cfg.source_name,
+            params.probes.len(),
+            params.pressure_sensors.len(),
+        )?;
+    }
+    if !(iox.dds_outputs || iox.outputs || iox.particles) {
+        anyhow::bail!(
+            "{}: iceoryx2.dds_outputs: false publishes nothing; set iceoryx2.outputs: true (and iceoryx2.particles) or leave dds_outputs true",
+            cfg.source_name
+        );
+    }
+    let iox_node = if iox_on {
+        Some(
+            crate::iox::node(&format!("slosh_{}", names.node))
+                .map_err(|e| anyhow::anyhow!("iceoryx2 (service {:?}): {e}", iox.service))?,
+        )
+    } else {
+        None
+    };
     let input = match c.input.kind {
+        InputType::Iceoryx2 => Input::Iox(
+            crate::iox::motion_subscriber(iox_node.as_ref().expect("created above"), &iox.service)?,
+            names.resolve("motion/accel")?,
+            c.frames.vessel.clone(),
+        ),
         InputType::Imu => Input::Imu(super::subscription(&mut node, &names, topic, &qos_input())?),
         InputType::Odom => {
             Input::Odom(super::subscription(&mut node, &names, topic, &qos_input())?)
@@ -294,12 +372,20 @@ pub fn run(
             None
         };
     let out_qos = qos_outputs();
-    let pub_wrench: Publisher<WrenchStamped> =
-        super::publisher(&mut node, &names, "wrench", &out_qos)?;
-    let pub_probes: Publisher<ProbeArray> =
-        super::publisher(&mut node, &names, "probes", &out_qos)?;
-    let pub_press: Publisher<PressureArray> =
-        super::publisher(&mut node, &names, "pressures", &out_qos)?;
+    // (wrench, probes, pressures) over DDS unless iceoryx2 alone carries them.
+    let pub_outputs: Option<(
+        Publisher<WrenchStamped>,
+        Publisher<ProbeArray>,
+        Publisher<PressureArray>,
+    )> = if iox.dds_outputs {
+        Some((
+            super::publisher(&mut node, &names, "wrench", &out_qos)?,
+            super::publisher(&mut node, &names, "probes", &out_qos)?,
+            super::publisher(&mut node, &names, "pressures", &out_qos)?,
+        ))
+    } else {
+        None
+    };
     let pub_diag: Publisher<DiagnosticArray> =
         super::publisher(&mut node, &names, "/diagnostics", &out_qos)?;
     let pub_tf: Publisher<TFMessage> =
@@ -308,7 +394,14 @@ pub fn run(
         RealtimeMode::Lockstep => Some(super::publisher(&mut node, &names, "/clock", &out_qos)?),
         _ => None,
     };
-    let pub_cloud: Option<Publisher<PointCloud2>> = if c.particles.rate_hz > 0.0 {
+    if iox.particles && c.particles.rate_hz <= 0.0 {
+        anyhow::bail!(
+            "{}: iceoryx2.particles: set particles.rate_hz (frames per simulated second) above 0",
+            cfg.source_name
+        );
+    }
+    let pub_cloud: Option<Publisher<PointCloud2>> = if c.particles.rate_hz > 0.0 && iox.dds_outputs
+    {
         let qos = QosProfile::publisher_default()
             .reliability_reliable(WhenFull::Wait(Duration::from_millis(20)))
             .history(History::KeepLast { depth: 1 });
@@ -361,8 +454,25 @@ pub fn run(
         max_speed: c.input.max_speed,
         max_rotation_rate: c.input.max_rotation_rate,
     };
-    let mut motion = Live::new(imu, limits, &frames, params.gravity);
+    let fresh_motion = || {
+        if c.input.kind == InputType::Iceoryx2 {
+            Live::states(limits, &frames)
+        } else {
+            Live::new(imu, limits, &frames, params.gravity)
+        }
+    };
+    let mut motion = fresh_motion();
     let mut sim = sph::build(params.clone())?;
+    let mut iox_ports = match &iox_node {
+        Some(n) if iox.outputs || iox.particles => Some(crate::iox::OutputPorts::new(
+            n,
+            &iox.service,
+            iox.particles
+                .then_some(sim.counts().fluid + sim.counts().boundary),
+        )?),
+        _ => None,
+    };
+    let mut steps_at_output = 0u64;
     let in_topic = names.resolve(topic)?;
     let out_topics = [
         names.resolve("wrench")?,
@@ -404,7 +514,11 @@ pub fn run(
             params.particle_spacing,
             resolution,
             c.realtime.mode,
-            in_topic
+            if c.input.kind == InputType::Iceoryx2 {
+                format!("iceoryx2 service {}/motion", iox.service)
+            } else {
+                in_topic.clone()
+            }
         ),
     );
 
@@ -434,7 +548,7 @@ pub fn run(
         // 0. Services: ~/reset starts the liquid again at rest, ~/pause freezes the simulation.
         while let Ok(Some((id, _))) = srv_reset.receive_request() {
             sim = sph::build(params.clone())?;
-            motion = Live::new(imu, limits, &frames, params.gravity);
+            motion = fresh_motion();
             next_output = 0;
             next_cloud = 0;
             rebase = t0.is_some();
@@ -460,7 +574,7 @@ pub fn run(
             } else {
                 paused = false;
                 // Resume from the current input without catching up on the paused stretch.
-                motion = Live::new(imu, limits, &frames, params.gravity);
+                motion = fresh_motion();
                 rebase = t0.is_some();
                 format!("resumed at t = {:.4} s", sim.time())
             };
@@ -635,15 +749,26 @@ pub fn run(
                     if let Some(r) = recorder.as_mut() {
                         r.write_outputs(&out_topics, stamp, &m)?;
                     }
-                    publish(&pub_wrench, m.wrench, "wrench")?;
-                    publish(&pub_probes, m.probes, "probes")?;
-                    publish(&pub_press, m.pressures, "pressures")?;
+                    if let Some((pw, pp, ps)) = &pub_outputs {
+                        publish(pw, m.wrench, "wrench")?;
+                        publish(pp, m.probes, "probes")?;
+                        publish(ps, m.pressures, "pressures")?;
+                    }
+                    if let (Some(p), true) = (iox_ports.as_ref(), iox.outputs) {
+                        let mut so = crate::iox::outputs_of(base + o.time, &o);
+                        so.steps = (sim.stats().steps - steps_at_output) as u32;
+                        p.publish(&so)?;
+                    }
+                    steps_at_output = sim.stats().steps;
                     if let Some(pc) = &pub_clock {
                         publish(pc, Clock { clock: stamp }, "/clock")?;
                     }
                     counters.published += 1;
-                    if let Some(pc) = &pub_cloud {
-                        if t >= next_cloud as f64 / c.particles.rate_hz - 1e-9 {
+                    if c.particles.rate_hz > 0.0
+                        && t >= next_cloud as f64 / c.particles.rate_hz - 1e-9
+                    {
+                        // The cloud is recorded even when only iceoryx2 publishes.
+                        if pub_cloud.is_some() || recorder.is_some() {
                             let cloud = super::cloud::particle_cloud(
                                 stamp,
                                 &c.frames.tank,
@@ -654,9 +779,14 @@ pub fn run(
                             if let Some(r) = recorder.as_mut() {
                                 r.write(&cloud_topic, stamp, &cloud)?;
                             }
-                            publish(pc, cloud, "particles")?;
-                            next_cloud = (t * c.particles.rate_hz + 1e-9).floor() as u64 + 1;
+                            if let Some(pc) = &pub_cloud {
+                                publish(pc, cloud, "particles")?;
+                            }
                         }
+                        if let (Some(p), true) = (iox_ports.as_mut(), iox.particles) {
+                            p.publish_particles(base + o.time, &sim.snapshot())?;
+                        }
+                        next_cloud = (t * c.particles.rate_hz + 1e-9).floor() as u64 + 1;
                     }
                     next_output = (t * rate + 1e-9).floor() as u64 + 1;
                 }
