@@ -17,3 +17,4 @@ pub mod resolution;
 pub mod ros;
 pub mod runner;
 pub mod snapshot;
+pub mod transport_bench;

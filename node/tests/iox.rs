@@ -367,6 +367,20 @@ fn the_node_takes_motion_and_gives_outputs_and_particles_over_iceoryx2_like_slos
         .subscriber_builder()
         .create()
         .unwrap();
+    // The shipped example consumer, reading beside the test.
+    let example = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .join("examples/consumer");
+    let consumer = Command::new(&example)
+        .args(["--service", "tank1", "--outputs", "21"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
     let bag = dir.join("bag");
     let mut node_proc = Server(Some(
         node_cmd(&[
@@ -425,6 +439,28 @@ fn the_node_takes_motion_and_gives_outputs_and_particles_over_iceoryx2_like_slos
     while let Some(s) = outs.receive().unwrap() {
         got.push(*s.payload());
     }
+
+    let c = consumer.wait_with_output().unwrap();
+    assert!(c.status.success());
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&c.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let outs_seen: Vec<&serde_json::Value> =
+        lines.iter().filter(|l| l.get("t").is_some()).collect();
+    assert_eq!(outs_seen.len(), 21, "{lines:?}");
+    for (l, o) in outs_seen.iter().zip(&got) {
+        // (serde_json's default float parsing may be off in the last bit)
+        let fx = l["force"][0].as_f64().unwrap();
+        assert!(
+            (fx - o.force[0]).abs() <= 1e-12 * o.force[0].abs().max(1.0),
+            "{fx} vs {}",
+            o.force[0]
+        );
+    }
+    assert!(lines
+        .iter()
+        .any(|l| l["fluid"] == 400 && l["max_speed"].as_f64().unwrap() > 0.0));
 
     // The same case offline, the motion known exactly; both observe at the first step at or after k / 20 s.
     let o = slosh()
@@ -496,4 +532,54 @@ fn the_node_takes_motion_and_gives_outputs_and_particles_over_iceoryx2_like_slos
     drop(viewer);
     iox.assert_clean();
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bench_transport_times_both_transports_and_leaves_nothing_behind() {
+    if !common::in_private_netns("bench_transport_times_both_transports_and_leaves_nothing_behind")
+    {
+        return;
+    }
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let iox = Iox::new("bench");
+    let o = slosh()
+        .args(["bench-transport", "--round-trips", "50", "--frames", "3"])
+        .args(["--particles", "1000", "--particles", "20000", "--json"])
+        .env("ROS_DOMAIN_ID", "62")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows: Vec<serde_json::Value> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    // A latency and two frame sizes per transport.
+    assert_eq!(rows.len(), 6, "{rows:?}");
+    for t in ["iceoryx2", "dds"] {
+        let lat = rows
+            .iter()
+            .find(|r| r["transport"] == t && r["round_trips"] == 50)
+            .unwrap_or_else(|| panic!("no {t} latency in {rows:?}"));
+        let (p50, max) = (
+            lat["p50_us"].as_f64().unwrap(),
+            lat["max_us"].as_f64().unwrap(),
+        );
+        assert!(p50 > 0.0 && p50 <= max, "{lat}");
+        for n in [1000, 20000] {
+            let f = rows
+                .iter()
+                .find(|r| r["transport"] == t && r["particles"] == n)
+                .unwrap_or_else(|| panic!("no {t} frames of {n} in {rows:?}"));
+            assert_eq!(f["bytes_per_frame"], 32 * n);
+            assert_eq!(f["frames"], 3);
+            assert!(f["frames_per_s"].as_f64().unwrap() > 0.0, "{f}");
+        }
+    }
+    let o = slosh()
+        .args(["bench-transport", "--transport", "zmq"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("iceoryx2 or dds"));
+    iox.assert_clean();
 }
