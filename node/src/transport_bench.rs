@@ -224,7 +224,7 @@ fn iox_frames(particles: usize, frames: usize) -> anyhow::Result<Vec<f64>> {
     let done = Arc::new(AtomicBool::new(false));
     let (d, nm) = (done.clone(), name.clone());
     let ack_name: ServiceName = format!("{name}/ack").as_str().try_into()?;
-    let ack_name2 = ack_name.clone();
+    let ack_name2 = ack_name;
     let receiver = std::thread::spawn(move || -> anyhow::Result<()> {
         let node = iox::node("slosh_bench_viewer")?;
         let sub = iox::particles_service(&node, &nm)?
