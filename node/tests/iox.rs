@@ -380,6 +380,13 @@ fn the_node_takes_motion_and_gives_outputs_and_particles_over_iceoryx2_like_slos
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
+    // And one that is killed mid-run: the node goes on.
+    let victim = Command::new(&example)
+        .args(["--service", "tank1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
     std::thread::sleep(Duration::from_millis(300));
     let bag = dir.join("bag");
     let mut node_proc = Server(Some(
@@ -411,11 +418,18 @@ fn the_node_takes_motion_and_gives_outputs_and_particles_over_iceoryx2_like_slos
             .unwrap(),
     ));
     let (mut got, mut frames) = (vec![], vec![]);
+    let mut victim = Some(victim);
     let end = Instant::now() + Duration::from_secs(120);
     let mut exited = None;
     while Instant::now() < end {
         while let Some(s) = outs.receive().unwrap() {
             got.push(*s.payload());
+        }
+        if got.len() >= 5 {
+            if let Some(mut v) = victim.take() {
+                v.kill().unwrap();
+                v.wait().unwrap();
+            }
         }
         while let Some(s) = parts.receive().unwrap() {
             let p = s.payload();

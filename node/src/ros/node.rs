@@ -544,7 +544,15 @@ pub fn run(
     // After a reset or a resume the next sample is placed at the current simulation time.
     let mut rebase = false;
 
+    let mut last_cleanup = Instant::now();
     while !stop.load(Ordering::Relaxed) {
+        // iceoryx2 peers killed mid-run leave their resources behind: remove them now and then.
+        if let Some(n) = &iox_node {
+            if last_cleanup.elapsed() > Duration::from_secs(1) {
+                let _ = n.try_cleanup_dead_nodes();
+                last_cleanup = Instant::now();
+            }
+        }
         // 0. Services: ~/reset starts the liquid again at rest, ~/pause freezes the simulation.
         while let Ok(Some((id, _))) = srv_reset.receive_request() {
             sim = sph::build(params.clone())?;
