@@ -597,3 +597,49 @@ fn bench_transport_times_both_transports_and_leaves_nothing_behind() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("iceoryx2 or dds"));
     iox.assert_clean();
 }
+
+#[test]
+fn the_python_example_couples_step_for_step_like_the_rust_one() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let iox = Iox::new("py");
+    let dir = tmp("iox-py");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, CASE).unwrap();
+    // Each example against a fresh server: the same barge, so the same samples and the same liquid.
+    let run = |cmd: &mut Command| -> Vec<serde_json::Value> {
+        let srv = server(&case, &["--max-steps", "21"]);
+        let o = cmd
+            .args(["--service", "t", "--steps", "20"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(finish(srv)["steps_answered"], 21);
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let examples = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .join("examples");
+    let rust = run(&mut Command::new(examples.join("couple")));
+    let python = run(Command::new(common::python())
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/couple.py")));
+    assert_eq!((rust.len(), python.len()), (21, 21));
+    // couple.rs prints x to 6 and fx to 4 decimals.
+    for (r, p) in rust.iter().zip(&python) {
+        let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
+        assert!((f(r, "t") - f(p, "t")).abs() < 1e-9, "{r} vs {p}");
+        assert!((f(r, "x") - f(p, "x")).abs() < 1e-6, "{r} vs {p}");
+        assert!((f(r, "fx") - f(p, "fx")).abs() < 1e-4, "{r} vs {p}");
+        assert_eq!(r["steps"], p["steps"]);
+        assert_eq!(p["probes"].as_array().unwrap().len(), 2);
+    }
+    assert!(f64::abs(python[20]["x"].as_f64().unwrap()) > 0.0);
+    iox.assert_clean();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
