@@ -224,7 +224,6 @@ fn iox_frames(particles: usize, frames: usize) -> anyhow::Result<Vec<f64>> {
     let done = Arc::new(AtomicBool::new(false));
     let (d, nm) = (done.clone(), name.clone());
     let ack_name: ServiceName = format!("{name}/ack").as_str().try_into()?;
-    let ack_name2 = ack_name;
     let receiver = std::thread::spawn(move || -> anyhow::Result<()> {
         let node = iox::node("slosh_bench_viewer")?;
         let sub = iox::particles_service(&node, &nm)?
@@ -237,7 +236,7 @@ fn iox_frames(particles: usize, frames: usize) -> anyhow::Result<Vec<f64>> {
             .listener_builder()
             .create()?;
         let ack = node
-            .service_builder(&ack_name2)
+            .service_builder(&ack_name)
             .event()
             .open_or_create()?
             .notifier_builder()
@@ -326,17 +325,24 @@ fn qos() -> QosProfile {
         .history(History::KeepLast { depth: 4 })
 }
 
+/// The DDS topic `/slosh_bench/<topic>` of message type `M`.
+fn dds_topic<M: RosMessage>(
+    node: &mut ros2_client::Node,
+    topic: &str,
+) -> anyhow::Result<ros2_client::dds::rustdds::Topic> {
+    node.create_topic(
+        &Name::new("/slosh_bench", topic).map_err(|e| anyhow::anyhow!("{e:?}"))?,
+        MessageTypeName::new(M::PACKAGE, M::NAME),
+        &qos(),
+    )
+    .map_err(|e| anyhow::anyhow!("{e:?}"))
+}
+
 fn dds_pub<M: RosMessage>(
     node: &mut ros2_client::Node,
     topic: &str,
 ) -> anyhow::Result<ros2_client::Publisher<M>> {
-    let t = node
-        .create_topic(
-            &Name::new("/slosh_bench", topic).map_err(|e| anyhow::anyhow!("{e:?}"))?,
-            MessageTypeName::new(M::PACKAGE, M::NAME),
-            &qos(),
-        )
-        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let t = dds_topic::<M>(node, topic)?;
     node.create_publisher(&t, Some(qos()))
         .map_err(|e| anyhow::anyhow!("{e:?}"))
 }
@@ -345,13 +351,7 @@ fn dds_sub<M: RosMessage + 'static>(
     node: &mut ros2_client::Node,
     topic: &str,
 ) -> anyhow::Result<ros2_client::Subscription<M>> {
-    let t = node
-        .create_topic(
-            &Name::new("/slosh_bench", topic).map_err(|e| anyhow::anyhow!("{e:?}"))?,
-            MessageTypeName::new(M::PACKAGE, M::NAME),
-            &qos(),
-        )
-        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let t = dds_topic::<M>(node, topic)?;
     node.create_subscription(&t, Some(qos()))
         .map_err(|e| anyhow::anyhow!("{e:?}"))
 }

@@ -126,13 +126,21 @@ fn finish(mut s: Server) -> serde_json::Value {
     serde_json::from_slice(&o.stdout).unwrap()
 }
 
+/// A CSV of `slosh run`, its rows of numbers.
 fn csv(path: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
+    common::csv(path).1
+}
+
+/// A shipped example, built beside the test binaries.
+fn example(name: &str) -> PathBuf {
+    std::env::current_exe()
         .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect()
+        .parent()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .join("examples")
+        .join(name)
 }
 
 #[test]
@@ -231,13 +239,7 @@ fn the_example_client_couples_particles_flow_and_a_killed_client_disturbs_nothin
         .unwrap();
 
     // The shipped example: a barge on a spring, 20 coupled steps of 10 ms.
-    let example = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .join("examples/couple");
+    let example = example("couple");
     let o = Command::new(&example)
         .args(["--service", "t", "--steps", "20"])
         .output()
@@ -368,13 +370,7 @@ fn the_node_takes_motion_and_gives_outputs_and_particles_over_iceoryx2_like_slos
         .create()
         .unwrap();
     // The shipped example consumer, reading beside the test.
-    let example = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .join("examples/consumer");
+    let example = example("consumer");
     let consumer = Command::new(&example)
         .args(["--service", "tank1", "--outputs", "21"])
         .stdout(Stdio::piped())
@@ -619,14 +615,7 @@ fn the_python_example_couples_step_for_step_like_the_rust_one() {
             .map(|l| serde_json::from_str(l).unwrap())
             .collect()
     };
-    let examples = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .join("examples");
-    let rust = run(&mut Command::new(examples.join("couple")));
+    let rust = run(&mut Command::new(example("couple")));
     let python = run(Command::new(common::python())
         .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/couple.py")));
     assert_eq!((rust.len(), python.len()), (21, 21));

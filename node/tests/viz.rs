@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{python, slosh, tmp};
+use common::{slosh, tmp};
 use sph::observe::snapshot::Snapshot;
 use std::path::{Path, PathBuf};
 
@@ -46,19 +46,11 @@ fn summary(dir: &Path) -> serde_json::Value {
 
 /// What meshio read from a frame or a series (tests/py/read_vtu.py).
 fn meshio(path: &Path) -> serde_json::Value {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/py/read_vtu.py");
-    let o = std::process::Command::new(python())
-        .arg(script)
-        .arg(path)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "meshio failed on {}: {}",
-        path.display(),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    serde_json::from_slice(&o.stdout).unwrap()
+    common::py_json(
+        "read_vtu.py",
+        &[path.as_os_str()],
+        &format!("meshio failed on {}", path.display()),
+    )
 }
 
 fn f64s(v: &serde_json::Value) -> Vec<f64> {

@@ -2,8 +2,7 @@
 //! paced by the wall clock, for a node with `input.type: iceoryx2` (no DDS involved).
 
 use super::*;
-use crate::motion_source;
-use crate::ros::motion_pub::MotionOptions;
+use crate::ros::motion_pub::{checked_motion, MotionOptions};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
@@ -18,27 +17,7 @@ pub fn run(
             "--iceoryx2: --lockstep, --pose, --imu and --accel are DDS options; an iceoryx2 sample carries the full state"
         );
     }
-    if !(opts.rate_hz.is_finite() && opts.rate_hz > 0.0) {
-        anyhow::bail!(
-            "--rate: must be a positive number of samples per second, got {}",
-            opts.rate_hz
-        );
-    }
-    if !(opts.duration.is_finite() && opts.duration > 0.0) {
-        anyhow::bail!(
-            "--duration: must be a positive number of seconds, got {}",
-            opts.duration
-        );
-    }
-    let cfg = crate::config::load(config, params)?;
-    let motion = motion_source::build(&cfg)?;
-    if opts.duration > motion.end_time() {
-        anyhow::bail!(
-            "--duration {} s: the motion ends at t = {} s",
-            opts.duration,
-            motion.end_time()
-        );
-    }
+    let (_, motion) = checked_motion(config, params, opts)?;
     let node = node("slosh_motion")?;
     let svc = motion_service(&node, service)?;
     let publisher = svc.publisher_builder().create()?;
@@ -55,12 +34,7 @@ pub fn run(
             std::thread::sleep(Duration::from_millis(10));
         }
     }
-    let start_stamp = opts.start_stamp.unwrap_or_else(|| {
-        std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.as_secs_f64())
-            .unwrap_or(0.0)
-    });
+    let start_stamp = opts.start_stamp();
     let n = (opts.duration * opts.rate_hz).round() as u64;
     eprintln!(
         "slosh motion: publishing {n} samples at {} Hz on iceoryx2 {service}/motion",

@@ -145,10 +145,9 @@ impl OutputPorts {
         let Some(p) = &self.particles else {
             return Ok(());
         };
-        let sample = p
+        let mut sample = p
             .loan_slice_uninit(snap.len())
             .map_err(|e| anyhow::anyhow!("loaning an iceoryx2 particle frame: {e}"))?;
-        let mut sample = sample;
         *sample.user_header_mut() = ParticleHeader {
             time,
             fluid: snap.fluid as u64,

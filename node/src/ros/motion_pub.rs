@@ -101,8 +101,25 @@ pub fn imu(s: &RigidState, stamp: Time, body: &str, gravity: f64) -> Imu {
     }
 }
 
-/// Publishes until the duration is reached or SIGINT/SIGTERM.
-pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<()> {
+impl MotionOptions {
+    /// The stamp of the first sample: `start_stamp`, or now (seconds since the epoch).
+    pub fn start_stamp(&self) -> f64 {
+        self.start_stamp.unwrap_or_else(|| {
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_secs_f64())
+                .unwrap_or(0.0)
+        })
+    }
+}
+
+/// The case (`config` with `params` overrides) and its motion, once `--rate` and `--duration` are checked and the
+/// motion lasts the duration (for either transport of `slosh motion`).
+pub fn checked_motion(
+    config: &str,
+    params: &[String],
+    opts: &MotionOptions,
+) -> anyhow::Result<(crate::config::Loaded, Box<dyn sph::motion::TankMotion>)> {
     if !(opts.rate_hz.is_finite() && opts.rate_hz > 0.0) {
         anyhow::bail!(
             "--rate: must be a positive number of samples per second, got {}",
@@ -115,7 +132,7 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
             opts.duration
         );
     }
-    let cfg = crate::config::load(config, &ros.params)?;
+    let cfg = crate::config::load(config, params)?;
     let motion = motion_source::build(&cfg)?;
     if opts.duration > motion.end_time() {
         anyhow::bail!(
@@ -124,6 +141,12 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
             motion.end_time()
         );
     }
+    Ok((cfg, motion))
+}
+
+/// Publishes until the duration is reached or SIGINT/SIGTERM.
+pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<()> {
+    let (cfg, motion) = checked_motion(config, &ros.params, opts)?;
     let names = Names::new(ros, "slosh_motion")?;
     let stop = super::shutdown_flag()?;
     let context = super::context()?;
@@ -198,12 +221,7 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
         // Let the matching finish on both sides before the first sample.
         std::thread::sleep(Duration::from_millis(500));
     }
-    let start_stamp = opts.start_stamp.unwrap_or_else(|| {
-        std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.as_secs_f64())
-            .unwrap_or(0.0)
-    });
+    let start_stamp = opts.start_stamp();
     let n = (opts.duration * opts.rate_hz).round() as u64;
     let lead = 4u64;
     let mut clock_t = f64::NEG_INFINITY;

@@ -97,41 +97,44 @@ pub fn case_dir(name: &str, extra: &str) -> (PathBuf, PathBuf) {
     (dir, case)
 }
 
-/// What the third-party bag readers decoded (tests/py/read_bag.py: rosbags and mcap + mcap-ros2-support).
-pub fn read_bag(bag: &std::path::Path) -> serde_json::Value {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/py/read_bag.py");
+/// Runs the Python peer `tests/py/<script>` with `args` and returns what it printed, as JSON; a failure is
+/// reported as `failure` followed by its stderr.
+pub fn py_json(script: &str, args: &[&std::ffi::OsStr], failure: &str) -> serde_json::Value {
+    let path = format!("{}/../tests/py/{script}", env!("CARGO_MANIFEST_DIR"));
     let out = Command::new(python())
-        .arg(script)
-        .arg(bag)
+        .arg(path)
+        .args(args)
         .output()
         .unwrap();
     assert!(
         out.status.success(),
-        "the readers failed on {}: {}",
-        bag.display(),
+        "{failure}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+/// What the third-party bag readers decoded (tests/py/read_bag.py: rosbags and mcap + mcap-ros2-support).
+pub fn read_bag(bag: &std::path::Path) -> serde_json::Value {
+    py_json(
+        "read_bag.py",
+        &[bag.as_os_str()],
+        &format!("the readers failed on {}", bag.display()),
+    )
+}
+
 /// The shipped Foxglove layout checked against a recorded bag (tests/py/check_layout.py, decoding with
 /// rosbags); `namespace` is where the node's relative topic names went (e.g. "/ship1", or "").
 pub fn check_layout(bag: &std::path::Path, namespace: &str) -> serde_json::Value {
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
-    let out = Command::new(python())
-        .arg(format!("{root}/tests/py/check_layout.py"))
-        .arg(format!("{root}/launch-configs/foxglove_layout.json"))
-        .arg(bag)
-        .arg(namespace)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "the layout does not fit the recording {}: {}",
-        bag.display(),
-        String::from_utf8_lossy(&out.stderr)
+    let layout = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../launch-configs/foxglove_layout.json"
     );
-    serde_json::from_slice(&out.stdout).unwrap()
+    py_json(
+        "check_layout.py",
+        &[layout.as_ref(), bag.as_os_str(), namespace.as_ref()],
+        &format!("the layout does not fit the recording {}", bag.display()),
+    )
 }
 
 /// The `slosh` binary under test.
