@@ -70,9 +70,15 @@ pub struct BenchResult {
     pub iterations_per_step: f64,
 }
 
-/// Runs one case for `duration` simulated seconds (setup excluded from the timing).
-pub fn run_case(case: &Case, duration: Option<f64>) -> anyhow::Result<BenchResult> {
-    let overrides: Vec<String> = case.overrides.iter().map(|s| s.to_string()).collect();
+/// Runs one case for `duration` simulated seconds (setup excluded from the timing), with `set` (KEY=VALUE)
+/// applied after the case's own overrides.
+pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::Result<BenchResult> {
+    let overrides: Vec<String> = case
+        .overrides
+        .iter()
+        .map(|s| s.to_string())
+        .chain(set.iter().cloned())
+        .collect();
     let cfg = config::load(case.builtin, &overrides)?;
     let params = cfg.sim_params()?;
     let motion: Box<dyn TankMotion> = crate::motion_source::build(&cfg)?;

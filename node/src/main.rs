@@ -130,6 +130,9 @@ enum Command {
         /// Simulated seconds per case (default: each case's own).
         #[arg(long)]
         duration: Option<f64>,
+        /// Override a setting of every case after its own (`--set solver.dfsph.max_density_error=1e-3`).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
         /// Print one JSON object per case instead of a table.
         #[arg(long)]
         json: bool,
@@ -543,6 +546,7 @@ fn main() -> anyhow::Result<()> {
         Command::Bench {
             case,
             duration,
+            set,
             json,
         } => {
             let cases: Vec<&bench::Case> = if case.is_empty() {
@@ -578,7 +582,7 @@ fn main() -> anyhow::Result<()> {
                 );
             }
             for c in cases {
-                let r = bench::run_case(c, duration)?;
+                let r = bench::run_case(c, duration, &set)?;
                 if json {
                     println!("{}", serde_json::to_string(&r)?);
                 } else {
