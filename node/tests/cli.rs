@@ -271,3 +271,54 @@ fn the_incompressible_scheme_runs_and_reports_its_pressure_solver() {
         "{e}"
     );
 }
+
+#[test]
+fn bench_reports_json_and_applies_overrides() {
+    let st = slosh()
+        .args([
+            "bench",
+            "--case",
+            "seed_2d_dp8mm_dfsph",
+            "--duration",
+            "0.05",
+            "--set",
+            "particle_spacing=0.02",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let r: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
+    assert_eq!(r["case"], "seed_2d_dp8mm_dfsph");
+    // 0.8 m × 0.39 m at 20 mm instead of 8 mm: 40 × 19 or so liquid particles, not 4,900.
+    let n = r["particles_fluid"].as_u64().unwrap();
+    assert!((500..1000).contains(&n), "{n} liquid particles");
+    assert!(r["steps"].as_u64().unwrap() > 0);
+    assert!(r["sim_time_s"].as_f64().unwrap() >= 0.05 - 1e-9);
+    for k in ["particle_steps_per_s", "realtime_factor", "iterations_per_step"] {
+        assert!(r[k].as_f64().unwrap() > 0.0, "{k}: {r}");
+    }
+    // A misspelt setting is refused by name, not ignored.
+    let st = slosh()
+        .args([
+            "bench",
+            "--case",
+            "seed_2d_dp8mm_dfsph",
+            "--duration",
+            "0.01",
+            "--set",
+            "solver.dfsph.dt_maxx=0.003",
+        ])
+        .output()
+        .unwrap();
+    assert!(!st.status.success());
+    assert!(
+        String::from_utf8_lossy(&st.stderr).contains("dt_maxx"),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+}
