@@ -218,6 +218,7 @@ pub fn drive(
                 "max_density_error": stats.max_density_error,
                 "tolerance": params.solver.dfsph.max_density_error,
                 "unconverged_steps": stats.unconverged_steps,
+                "retried_steps": stats.retried_steps,
             })
         }),
         parameters: cfg.parameters.clone(),

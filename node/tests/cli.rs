@@ -299,7 +299,11 @@ fn bench_reports_json_and_applies_overrides() {
     assert!((500..1000).contains(&n), "{n} liquid particles");
     assert!(r["steps"].as_u64().unwrap() > 0);
     assert!(r["sim_time_s"].as_f64().unwrap() >= 0.05 - 1e-9);
-    for k in ["particle_steps_per_s", "realtime_factor", "iterations_per_step"] {
+    for k in [
+        "particle_steps_per_s",
+        "realtime_factor",
+        "iterations_per_step",
+    ] {
         assert!(r[k].as_f64().unwrap() > 0.0, "{k}: {r}");
     }
     // A misspelt setting is refused by name, not ignored.

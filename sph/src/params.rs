@@ -62,6 +62,10 @@ pub struct DfsphSpec {
     pub max_iterations: u32,
     /// Run the divergence solver (more stable at large steps).
     pub divergence_solve: bool,
+    /// Pressure iterations a step should need: above it the next step is shorter (× 0.8), below half of it
+    /// longer again (× 1.1, up to `dt_max` and the CFL limit). A step whose constant-density solve stops at
+    /// `max_iterations` above the tolerance is solved again at half the step. 0 turns both off.
+    pub target_iterations: u32,
 }
 
 impl Default for DfsphSpec {
@@ -74,6 +78,7 @@ impl Default for DfsphSpec {
             min_iterations: 2,
             max_iterations: 100,
             divergence_solve: true,
+            target_iterations: 20,
         }
     }
 }
@@ -354,6 +359,15 @@ impl SimParams {
             positive("solver.dfsph.dt_max", d.dt_max)?;
             positive("solver.dfsph.max_density_error", d.max_density_error)?;
             positive("solver.dfsph.max_divergence_error", d.max_divergence_error)?;
+            if d.target_iterations > d.max_iterations {
+                return Err(err(
+                    "solver.dfsph.target_iterations",
+                    format!(
+                        "must be at most max_iterations ({}), got {}; 0 turns the control off",
+                        d.max_iterations, d.target_iterations
+                    ),
+                ));
+            }
             if d.max_iterations == 0 || d.min_iterations > d.max_iterations {
                 return Err(err(
                     "solver.dfsph.max_iterations",

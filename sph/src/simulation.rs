@@ -47,6 +47,8 @@ pub struct Stats {
     pub max_density_error: f64,
     /// Steps whose solve stopped at `max_iterations` above the tolerance.
     pub unconverged_steps: u64,
+    /// Steps solved again at half the step because their solve did not converge (`target_iterations`).
+    pub retried_steps: u64,
 }
 
 pub struct Simulation<const D: usize, K: Kernel> {
@@ -217,6 +219,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         st.max_density_error = st.max_density_error.max(r.density_error);
         if !r.converged {
             st.unconverged_steps += 1;
+        }
+        if r.retries > 0 {
+            st.retried_steps += 1;
         }
         st.force_evaluations += 1 + its as u64;
         debug_assert!(r.dt <= spec.dt_max);

@@ -661,3 +661,33 @@ fn snapshots_hold_every_particle_with_hydrostatic_pressure_and_change_nothing() 
             .all(|r| (980.0..1020.0).contains(r)));
     }
 }
+
+/// The iteration control shortens steps whose solve works too hard and solves a step that does not converge
+/// again at half the step, so that every step ends below the density tolerance; without it, a tight
+/// iteration cap leaves steps above the tolerance.
+#[test]
+fn dfsph_iteration_control_keeps_every_step_converged() {
+    let run = |target: u32| {
+        let mut p = dfsph(dam_break());
+        p.solver.dfsph.max_iterations = 12;
+        p.solver.dfsph.target_iterations = target;
+        p.solver.dfsph.dt_max = 0.004;
+        let mut sim = sph::build(p).unwrap();
+        sim.advance_to(&AtRest, 0.4).unwrap();
+        sim.stats()
+    };
+    let free = run(0);
+    let controlled = run(6);
+    eprintln!("uncontrolled {free:?}\ncontrolled {controlled:?}");
+    assert!(free.unconverged_steps > 0, "{free:?}");
+    assert_eq!(free.retried_steps, 0);
+    assert_eq!(controlled.unconverged_steps, 0, "{controlled:?}");
+    assert!(controlled.retried_steps > 0, "{controlled:?}");
+    // Shorter steps where the solver works hard: more of them, each cheaper.
+    assert!(controlled.steps > free.steps);
+    assert!(
+        (controlled.solver_iterations as f64 / controlled.steps as f64)
+            < (free.solver_iterations as f64 / free.steps as f64)
+    );
+    assert!(controlled.max_density_error <= 5.0e-4);
+}

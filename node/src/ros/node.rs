@@ -972,6 +972,7 @@ fn diagnostics(
                 kv("pressure_iterations", stats.last_iterations.to_string()),
                 kv("density_error", format!("{:.2e}", stats.last_density_error)),
                 kv("unconverged_steps", stats.unconverged_steps.to_string()),
+                kv("retried_steps", stats.retried_steps.to_string()),
                 kv("input_age_s", age),
                 kv("samples_accepted", c.accepted.to_string()),
                 kv("samples_rejected", c.rejected.to_string()),

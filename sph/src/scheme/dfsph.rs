@@ -98,6 +98,8 @@ pub struct Workspace<const D: usize> {
     ksum: Vec<f32>,
     /// The divergence solver's total k.
     kdiv: Vec<f32>,
+    /// Longest step the iteration control allows now (0: no limit yet).
+    dt_cap: f64,
     partials: Vec<Partial>,
 }
 
@@ -112,6 +114,8 @@ pub struct StepReport {
     /// Mean predicted density error at the end of the constant-density solve (fraction of ρ_rest).
     pub density_error: f64,
     pub converged: bool,
+    /// Times the step was solved again at half the step because the solve did not converge.
+    pub retries: u32,
 }
 
 /// The read-only inputs of the passes.
@@ -537,52 +541,86 @@ pub fn step<const D: usize, K: Kernel>(
     // dt from the flow speed and the accelerations.
     let vmax = built.max_speed as f64;
     let amax = built.totals.max_acc as f64;
-    let mut dt = spec.dt_max.min(dt_limit);
+    let mut dt = spec.dt_max;
     if vmax > 0.0 {
         dt = dt.min(spec.cfl * dp / vmax);
     }
     if amax > 0.0 {
         dt = dt.min(spec.cfl * (dp / amax).sqrt());
     }
-    report.dt = dt;
-    let dtf = dt as f32;
-    for (a, v) in work.vel.iter_mut().enumerate() {
-        *v = std::array::from_fn(|d| fluid.v[d][a]);
+    let mut control = spec.target_iterations > 0 && !prime;
+    if control && work.dt_cap > 0.0 {
+        dt = dt.min(work.dt_cap);
     }
-    work.kdiv.resize(n, 0.0);
-    work.kdiv.iter_mut().for_each(|k| *k = 0.0);
-    if spec.divergence_solve && !prime {
-        let (it, _, t) = work.solve(
+    if dt_limit < dt {
+        // Cut short to land on an output time or the end of the motion: says nothing about the step the
+        // flow allows.
+        dt = dt_limit;
+        control = false;
+    }
+    // Shortest step a solve that does not converge is retried at.
+    let dt_floor = dt / 16.0;
+    loop {
+        report.totals = built.totals;
+        let dtf = dt as f32;
+        for (a, v) in work.vel.iter_mut().enumerate() {
+            *v = std::array::from_fn(|d| fluid.v[d][a]);
+        }
+        work.kdiv.resize(n, 0.0);
+        work.kdiv.iter_mut().for_each(|k| *k = 0.0);
+        if spec.divergence_solve && !prime {
+            let (it, _, t) = work.solve(
+                c,
+                Mode::Divergence,
+                dtf,
+                spec.max_divergence_error,
+                (1, spec.max_iterations),
+                &fluid.kappa_div,
+            );
+            report.divergence_iterations += it;
+            report.totals.force = add(report.totals.force, t.force);
+            report.totals.moment = add(report.totals.moment, t.moment);
+            work.kdiv.copy_from_slice(&work.ksum);
+        }
+        for (v, a) in work.vel.iter_mut().zip(&work.acc) {
+            for d in 0..D {
+                v[d] += dtf * a[d];
+            }
+        }
+        let (it, err, t) = work.solve(
             c,
-            Mode::Divergence,
+            Mode::Density,
             dtf,
-            spec.max_divergence_error,
-            (1, spec.max_iterations),
-            &fluid.kappa_div,
+            spec.max_density_error,
+            (spec.min_iterations, spec.max_iterations),
+            &fluid.kappa,
         );
-        report.divergence_iterations = it;
+        report.density_iterations += it;
+        report.density_error = err;
+        report.converged = err <= spec.max_density_error;
         report.totals.force = add(report.totals.force, t.force);
         report.totals.moment = add(report.totals.moment, t.moment);
-        work.kdiv.copy_from_slice(&work.ksum);
-    }
-    for (v, a) in work.vel.iter_mut().zip(&work.acc) {
-        for d in 0..D {
-            v[d] += dtf * a[d];
+        if control {
+            // The next step's limit from this solve's effort.
+            if it > spec.target_iterations {
+                work.dt_cap = 0.8 * dt;
+            } else if 2 * it < spec.target_iterations {
+                work.dt_cap = (1.1 * work.dt_cap.max(dt)).min(spec.dt_max);
+            } else {
+                work.dt_cap = work.dt_cap.max(dt);
+            }
         }
+        let retry = spec.target_iterations > 0 && !prime && !report.converged;
+        if retry && err.is_finite() && 0.5 * dt >= dt_floor {
+            // Solve the step again, shorter (nothing has moved yet).
+            dt *= 0.5;
+            work.dt_cap = dt;
+            report.retries += 1;
+            continue;
+        }
+        break;
     }
-    let (it, err, t) = work.solve(
-        c,
-        Mode::Density,
-        dtf,
-        spec.max_density_error,
-        (spec.min_iterations, spec.max_iterations),
-        &fluid.kappa,
-    );
-    report.density_iterations = it;
-    report.density_error = err;
-    report.converged = err <= spec.max_density_error;
-    report.totals.force = add(report.totals.force, t.force);
-    report.totals.moment = add(report.totals.moment, t.moment);
+    report.dt = dt;
     if work.vel.iter().any(|v| !v.iter().all(|x| x.is_finite())) {
         report.totals.non_finite = true;
     }
