@@ -379,6 +379,13 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     /// Advances one time step; returns its length.
     pub fn step(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
+        // The step runs on a thread of rayon's pool: its parallel passes (some 40 a step for the
+        // incompressible scheme) then fork and join among the pool's own threads, instead of each waking the
+        // pool from outside and putting the calling thread to sleep until it is done.
+        rayon::scope(|_| self.step_here(motion))
+    }
+
+    fn step_here(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
         if self.params.solver.scheme == Scheme::Dfsph {
             return self.step_dfsph(motion);
         }

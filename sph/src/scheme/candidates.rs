@@ -13,13 +13,15 @@ pub const LANES: usize = 8;
 /// Where padding entries are put: far outside any support, small enough that squares stay finite in f32.
 const FAR: f32 = 1.0e15;
 
-/// Candidate neighbours (positions, velocities, densities, p/ρ²) in contiguous storage.
+/// Candidate neighbours (positions, velocities, densities, p/ρ², particle indices) in contiguous storage.
 #[derive(Clone, Debug)]
 pub struct Candidates<const D: usize> {
     pub x: [Vec<f32>; D],
     pub v: [Vec<f32>; D],
     pub r: Vec<f32>,
     pub pr2: Vec<f32>,
+    /// Index of each candidate in the particle arrays (padding: `u32::MAX`); filled by [`Self::fill_motion`].
+    pub idx: Vec<u32>,
 }
 
 impl<const D: usize> Default for Candidates<D> {
@@ -29,6 +31,7 @@ impl<const D: usize> Default for Candidates<D> {
             v: std::array::from_fn(|_| Vec::new()),
             r: Vec::new(),
             pr2: Vec::new(),
+            idx: Vec::new(),
         }
     }
 }
@@ -71,10 +74,55 @@ impl<const D: usize> Candidates<D> {
         self.pr2.resize(padded, 0.0);
     }
 
-    /// Number of blocks of [`LANES`].
+    /// Copies positions, velocities and indices only (densities and p/ρ² are left empty: use
+    /// [`Self::motion_blocks`] and [`Self::motion_block`]), padded like [`Self::fill`].
+    pub fn fill_motion(&mut self, ranges: &Ranges, n: usize, x: &[Vec<f32>; D], v: &[Vec<f32>; D]) {
+        for d in 0..D {
+            self.x[d].clear();
+            self.v[d].clear();
+        }
+        self.idx.clear();
+        self.r.clear();
+        self.pr2.clear();
+        for &(lo, hi) in &ranges[..n] {
+            let (lo, hi) = (lo as usize, hi as usize);
+            for d in 0..D {
+                self.x[d].extend_from_slice(&x[d][lo..hi]);
+                self.v[d].extend_from_slice(&v[d][lo..hi]);
+            }
+            self.idx.extend(lo as u32..hi as u32);
+        }
+        let padded = self.idx.len().div_ceil(LANES) * LANES;
+        for d in 0..D {
+            self.x[d].resize(padded, FAR);
+            self.v[d].resize(padded, 0.0);
+        }
+        self.idx.resize(padded, u32::MAX);
+    }
+
+    /// Number of blocks of [`LANES`] (after [`Self::fill`]).
     #[inline]
     pub fn blocks(&self) -> usize {
         self.r.len() / LANES
+    }
+
+    /// Number of blocks of [`LANES`] (after [`Self::fill_motion`]).
+    #[inline]
+    pub fn motion_blocks(&self) -> usize {
+        self.idx.len() / LANES
+    }
+
+    /// Block `b` after [`Self::fill_motion`]: positions, velocities and indices of its lanes.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    pub fn motion_block(&self, b: usize) -> ([[f32; LANES]; D], [[f32; LANES]; D], &[u32]) {
+        let s = b * LANES..(b + 1) * LANES;
+        let lane = |v: &[f32]| -> [f32; LANES] { v[s.clone()].try_into().expect("whole block") };
+        (
+            std::array::from_fn(|d| lane(&self.x[d])),
+            std::array::from_fn(|d| lane(&self.v[d])),
+            &self.idx[s.clone()],
+        )
     }
 
     /// Block `b`: positions, velocities, densities and p/ρ² of its lanes.
@@ -123,6 +171,13 @@ mod tests {
         assert!(bx[0][4..].iter().all(|&p| p == FAR));
         assert!(bv[1][4..].iter().all(|&p| p == 0.0));
         assert!(bp[4..].iter().all(|&p| p == 0.0));
+        c.fill_motion(&ranges, 2, &x, &v);
+        assert_eq!(c.motion_blocks(), 1);
+        let (bx, _, idx) = c.motion_block(0);
+        assert_eq!(idx, &[0, 1, 3, 4, u32::MAX, u32::MAX, u32::MAX, u32::MAX]);
+        assert_eq!(&bx[1][..4], &[5.0, 6.0, 8.0, 9.0]);
+        assert!(bx[1][4..].iter().all(|&p| p == FAR));
+        c.fill(&ranges, 2, &x, &v, &r, &p, 1000.0);
         // Refilling with fewer candidates forgets the old ones.
         c.fill(&ranges, 1, &x, &v, &r, &p, 1000.0);
         assert_eq!(c.r.len(), LANES);

@@ -152,7 +152,7 @@ fn interact<const D: usize, K: Kernel, const FLUID: bool>(
 
 /// Whether this CPU runs the pair loop with 256-bit lanes and fused multiply-add (checked once, cached by std).
 #[inline]
-fn wide_lanes() -> bool {
+pub(super) fn wide_lanes() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
