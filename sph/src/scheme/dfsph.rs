@@ -6,12 +6,15 @@
 //!    frame, so every wall term of the solver is this sum times the particle's own k or velocity), and adds
 //!    the non-pressure accelerations (the tank frame's apparent gravity and rotation terms, Monaghan's
 //!    artificial viscosity as in the weakly-compressible scheme);
-//! 2. takes dt = CFL · dp / |v|max (also bounded by the accelerations and `dt_max`);
+//! 2. takes dt = CFL · dp / |v|max (also bounded by the accelerations, `dt_max`, and the iteration control:
+//!    0.8× the last step after one that needed more than `target_iterations`, growing back 1.1× a step);
 //! 3. makes the velocity field divergence-free (the divergence solver), then predicts v* = v + dt·a and
 //!    corrects it until the mean predicted density error is below the tolerance (the constant-density
 //!    solver). Both start from half the last step's pressure (warm start) and iterate
 //!    `k_i = max(error_i, 0) · α_i / dt^n`,
 //!    `Δv_i = −dt Σ_j m_j (k_i + k_j) ∇W_ij − dt Σ_b m_b k_i ∇W_ib` (k plays p/ρ², so p = ρ² Σ k);
+//!    A constant-density solve that stops at `max_iterations` above the tolerance is done again, with the
+//!    divergence solve, at half the step (nothing has moved yet);
 //! 4. moves the particles with the corrected velocity.
 //!
 //! Walls are the dynamic boundary's particle layers, static in the tank frame, taking part in the density
