@@ -68,6 +68,10 @@ pub struct BenchResult {
     pub wall_s_per_sim_s: f64,
     /// Pressure-solver iterations per step (incompressible scheme; 0 for WCSPH).
     pub iterations_per_step: f64,
+    /// Steps that ended above the density tolerance, and steps solved again at half the step
+    /// (incompressible scheme; `solver.dfsph.target_iterations`).
+    pub unconverged_steps: u64,
+    pub retried_steps: u64,
 }
 
 /// Runs one case for `duration` simulated seconds (setup excluded from the timing), with `set` (KEY=VALUE)
@@ -100,5 +104,7 @@ pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::R
         realtime_factor: sim.time() / wall,
         wall_s_per_sim_s: wall / sim.time(),
         iterations_per_step: stats.solver_iterations as f64 / stats.steps.max(1) as f64,
+        unconverged_steps: stats.unconverged_steps,
+        retried_steps: stats.retried_steps,
     })
 }

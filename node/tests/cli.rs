@@ -306,6 +306,9 @@ fn bench_reports_json_and_applies_overrides() {
     ] {
         assert!(r[k].as_f64().unwrap() > 0.0, "{k}: {r}");
     }
+    for k in ["unconverged_steps", "retried_steps"] {
+        assert!(r[k].as_u64().is_some(), "{k}: {r}");
+    }
     // A misspelt setting is refused by name, not ignored.
     let st = slosh()
         .args([
