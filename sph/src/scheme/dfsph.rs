@@ -742,7 +742,9 @@ pub fn step<const D: usize, K: Kernel>(
         if retry && err.is_finite() && 0.5 * dt >= dt_floor {
             // Solve the step again, shorter (nothing has moved yet).
             dt *= 0.5;
-            work.dt_cap = dt;
+            if control {
+                work.dt_cap = dt;
+            }
             report.retries += 1;
             continue;
         }
