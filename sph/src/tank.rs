@@ -26,6 +26,16 @@ pub fn from3<T: Copy + Default, const D: usize>(p: [T; 3]) -> [T; D] {
     out
 }
 
+/// The cross product a × b.
+#[inline(always)]
+pub fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
 /// The inside of the tank as an axis-aligned box in the tank frame.
 #[derive(Clone, Copy, Debug)]
 pub struct TankBox<const D: usize> {

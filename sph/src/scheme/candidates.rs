@@ -10,6 +10,37 @@ use crate::neighbours::Ranges;
 /// Width of a block of pairs.
 pub const LANES: usize = 8;
 
+/// Sum of the lanes, in lane order.
+#[inline(always)]
+pub fn lane_sum(l: &[f32; LANES]) -> f32 {
+    l.iter().sum()
+}
+
+/// Whether this CPU runs the pair loops with 256-bit lanes and fused multiply-add (checked once, cached by
+/// std).
+#[inline]
+pub fn wide_lanes() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Uniform numbers in [−0.5, 0.5) from a fixed seed, for the pair-loop tests' jittered lattices.
+#[cfg(test)]
+pub fn test_noise(mut seed: u64) -> impl FnMut() -> f32 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 33) as f32 / (1u64 << 31) as f32) - 0.5
+    }
+}
+
 /// Where padding entries are put: far outside any support, small enough that squares stay finite in f32.
 const FAR: f32 = 1.0e15;
 

@@ -24,13 +24,13 @@
 //! the neighbour lists; every pass is a gather over fixed chunks that writes only its own particles, so
 //! results do not depend on the number of threads.
 
-use super::candidates::{Candidates, LANES};
+use super::candidates::{lane_sum, wide_lanes, Candidates, LANES};
 use super::{FrameTerms, PassTotals, CHUNK};
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DfsphSpec;
 use crate::particles::{Boundary, Fluid};
-use crate::tank::{from3, to3};
+use crate::tank::{cross, from3, to3};
 use rayon::prelude::*;
 
 /// How strongly walls push back on a liquid particle with k_i: `MIRROR · m_b k_i ∇W_ib` (1: Akinci et al.'s
@@ -169,10 +169,6 @@ struct HoodLanes<const D: usize> {
     walls: [f32; LANES],
 }
 
-fn lane_sum(l: &[f32; LANES]) -> f32 {
-    l.iter().sum()
-}
-
 /// The neighbourhood of liquid particle (xa, va) among the candidates of its cell (liquid `fc`, walls `bc`,
 /// at rest in the tank frame); appends its liquid neighbours (not itself) and their ∇W_ab to `j`/`g`.
 /// Branch-free over blocks of [`LANES`]: candidates beyond the support add nothing.
@@ -266,13 +262,11 @@ fn hood<const D: usize, K: Kernel>(
                 s.wall[d][l] += pair[d];
             }
             let xb = to3(std::array::from_fn::<f32, D, _>(|d| xs[d][l]));
-            let (fp, fk) = (to3(pair), to3(fk));
-            s.moment[0][l] += xb[1] * fp[2] - xb[2] * fp[1];
-            s.moment[1][l] += xb[2] * fp[0] - xb[0] * fp[2];
-            s.moment[2][l] += xb[0] * fp[1] - xb[1] * fp[0];
-            s.mb[0][l] += xb[1] * fk[2] - xb[2] * fk[1];
-            s.mb[1][l] += xb[2] * fk[0] - xb[0] * fk[2];
-            s.mb[2][l] += xb[0] * fk[1] - xb[1] * fk[0];
+            let (m, mk) = (cross(xb, to3(pair)), cross(xb, to3(fk)));
+            for e in 0..3 {
+                s.moment[e][l] += m[e];
+                s.mb[e][l] += mk[e];
+            }
             s.walls[l] += fin;
         }
     }
@@ -659,7 +653,7 @@ pub fn step<const D: usize, K: Kernel>(
         frame,
         fluid,
         bound,
-        wide: super::wcsph::wide_lanes(),
+        wide: wide_lanes(),
     };
     let built = work.build(&p);
     let mut report = StepReport {
@@ -871,13 +865,7 @@ mod tests {
         };
         // A jittered lattice of 7^D liquid particles with made-up velocities, and a row of wall particles
         // through its lower half.
-        let mut seed = 777u64;
-        let mut rnd = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 33) as f32 / (1u64 << 31) as f32) - 0.5
-        };
+        let mut rnd = super::super::candidates::test_noise(777);
         let n1 = 7usize;
         let mut x: [Vec<f32>; D] = std::array::from_fn(|_| Vec::new());
         let mut v: [Vec<f32>; D] = std::array::from_fn(|_| Vec::new());
@@ -922,7 +910,7 @@ mod tests {
             let mut fast = vec![hood(&k, &c, own, (&fc, &bc), &mut j, &mut g)];
             let mut lists = vec![j];
             #[cfg(target_arch = "x86_64")]
-            if super::super::wcsph::wide_lanes() {
+            if wide_lanes() {
                 let (mut j, mut g) = (Vec::new(), Vec::new());
                 // SAFETY: checked just above.
                 fast.push(unsafe { hood_avx2(&k, &c, own, (&fc, &bc), &mut j, &mut g) });

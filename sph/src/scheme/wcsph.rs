@@ -5,13 +5,13 @@
 //! Gather form: every liquid particle loops over its neighbours in cell-sorted order and writes only its own
 //! rates, so threads never share a write; chunks of fixed size make the sums independent of the thread count.
 
-use super::candidates::{Candidates, LANES};
+use super::candidates::{lane_sum, wide_lanes, Candidates, LANES};
 use super::{FrameTerms, PassTotals, CHUNK};
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DiffusionKind;
 use crate::particles::{Boundary, Fluid};
-use crate::tank::{from3, to3};
+use crate::tank::{cross, from3, to3};
 use rayon::prelude::*;
 
 /// Constants of the scheme in the precision of the loops.
@@ -56,12 +56,6 @@ impl<const D: usize> Acc<D> {
             moment: [[0.0; LANES]; 3],
         }
     }
-}
-
-/// Sum of the lanes, in lane order.
-#[inline(always)]
-fn sum(l: &[f32; LANES]) -> f32 {
-    l.iter().sum()
 }
 
 /// Sums the interactions of liquid particle `a` (position xa, velocity va, density ra, pa/ra²) with the
@@ -140,26 +134,15 @@ fn interact<const D: usize, K: Kernel, const FLUID: bool>(
                 for d in 0..D {
                     out.force[d][l] += pair[d];
                 }
-                let xb = to3(std::array::from_fn::<f32, D, _>(|d| xs[d][l]));
-                let fp = to3(pair);
-                out.moment[0][l] += xb[1] * fp[2] - xb[2] * fp[1];
-                out.moment[1][l] += xb[2] * fp[0] - xb[0] * fp[2];
-                out.moment[2][l] += xb[0] * fp[1] - xb[1] * fp[0];
+                let m = cross(
+                    to3(std::array::from_fn::<f32, D, _>(|d| xs[d][l])),
+                    to3(pair),
+                );
+                for (acc, m) in out.moment.iter_mut().zip(m) {
+                    acc[l] += m;
+                }
             }
         }
-    }
-}
-
-/// Whether this CPU runs the pair loop with 256-bit lanes and fused multiply-add (checked once, cached by std).
-#[inline]
-pub(super) fn wide_lanes() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
     }
 }
 
@@ -194,11 +177,11 @@ fn sums<const D: usize, K: Kernel>(
     interact::<D, K, true>(k, c, g, a.x, a.v, a.r, a.pr2, fc, &mut out);
     interact::<D, K, false>(k, c, g, a.x, a.v, a.r, a.pr2, bc, &mut out);
     Sums {
-        acc: std::array::from_fn(|d| sum(&out.acc[d])),
-        drho: sum(&out.drho),
+        acc: std::array::from_fn(|d| lane_sum(&out.acc[d])),
+        drho: lane_sum(&out.drho),
         max_mu: out.max_mu.iter().fold(0.0f32, |m, &u| m.max(u)),
-        force: std::array::from_fn(|d| sum(&out.force[d])),
-        moment: std::array::from_fn(|d| sum(&out.moment[d])),
+        force: std::array::from_fn(|d| lane_sum(&out.force[d])),
+        moment: std::array::from_fn(|d| lane_sum(&out.moment[d])),
     }
 }
 
@@ -476,13 +459,7 @@ mod tests {
             nu4: 0.0,
         };
         // A jittered lattice of 7^D particles around the origin, with made-up velocities and densities.
-        let mut seed = 12345u64;
-        let mut rnd = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 33) as f32 / (1u64 << 31) as f32) - 0.5
-        };
+        let mut rnd = super::super::candidates::test_noise(12345);
         let n1 = 7usize;
         let n = n1.pow(D as u32);
         let mut x: [Vec<f32>; D] = std::array::from_fn(|_| Vec::new());
