@@ -277,6 +277,18 @@ fn beside(bag: &std::path::Path, suffix: &str) -> PathBuf {
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
+    // Under mpirun every rank runs this binary: rank 0 goes on with the command (its simulations spread
+    // over all ranks), the others follow its solver calls until it is done.
+    #[cfg(feature = "mpi")]
+    let _lead = match sph::domain::mpi::start().map_err(anyhow::Error::msg)? {
+        sph::domain::mpi::Role::Follow => return Ok(()),
+        sph::domain::mpi::Role::Lead(l) => {
+            if l.ranks() > 1 {
+                eprintln!("slosh: MPI with {} ranks", l.ranks());
+            }
+            l
+        }
+    };
     match cli.command {
         Command::Bag {
             command: BagCommand::Repair { bag, out },

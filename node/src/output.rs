@@ -102,6 +102,10 @@ pub struct Summary {
     pub particle_steps_per_s: f64,
     pub min_dt_s: f64,
     pub liquid_mass_kg: f64,
+    /// Processes the liquid was spread over (MPI ranks; 1 for a run in one process), and how often the
+    /// subdomains were moved to even out their particle counts.
+    pub mpi_ranks: usize,
+    pub rebalances: u64,
     /// Why the run stopped early, if it did.
     pub error: Option<String>,
     /// The incompressible scheme's pressure solver: iterations (all, mean per step), largest mean density

@@ -200,6 +200,8 @@ pub fn drive(
             0.0
         },
         liquid_mass_kg: sim.liquid_mass(),
+        mpi_ranks: sim.ranks(),
+        rebalances: sim.rebalances(),
         error: result.as_ref().err().map(|e| e.to_string()),
         input: d.input,
         snapshots: snapshot_info.map(|(frames, dir, frame, hz)| {

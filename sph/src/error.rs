@@ -16,6 +16,8 @@ pub enum SimError {
     },
     #[error("all liquid particles have left the tank by t = {time:.6} s")]
     AllParticlesLost { time: f64 },
+    #[error("cannot spread the simulation over MPI ranks: {0}")]
+    Decomposition(String),
     #[error("the motion ends at t = {end:.6} s but the run was asked to go on to t = {time:.6} s: shorten --duration or extend the motion")]
     MotionEnded { time: f64, end: f64 },
 }

@@ -29,6 +29,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod boundary;
+pub mod domain;
 pub mod eos;
 pub mod error;
 pub mod integrate;

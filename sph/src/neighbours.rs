@@ -9,7 +9,7 @@
 pub const OUTSIDE: u32 = u32::MAX;
 
 /// How many cells away a neighbour can be.
-const REACH: i64 = 2;
+pub const REACH: i64 = 2;
 
 /// At most (2·REACH + 1)^(D−1) ranges per cell: 5 in 2D, 25 in 3D.
 pub type Ranges = [(u32, u32); 25];
@@ -60,6 +60,12 @@ impl<const D: usize> Grid<D> {
             hi[k] += self.dims[k] as f64 * self.cell;
         }
         (self.origin, hi)
+    }
+
+    /// Column of cells (index along x, unbounded) holding the abscissa `x`: subdomains are runs of columns.
+    #[inline]
+    pub fn column(&self, x: f64) -> i64 {
+        ((x - self.origin[0]) * self.inv_cell).floor() as i64
     }
 
     /// Cell holding `p`, or [`OUTSIDE`] (also for NaN).
@@ -186,6 +192,40 @@ pub fn counting_sort(
     }
     starts.truncate(n_cells + 1);
     inside
+}
+
+/// Puts the particles of each cell of a [`counting_sort`] in the order of `key` (unique per particle), so the
+/// order inside a cell does not depend on the order before sorting. A run is then reproducible from its
+/// state alone, and a subdomain's particles meet their neighbours in the same order as in one process (the
+/// sums come out bit for bit the same). `src` is scratch.
+pub fn order_cells_by(
+    key: impl Fn(usize) -> u32,
+    starts: &[u32],
+    dest: &mut [u32],
+    src: &mut Vec<u32>,
+    keep: usize,
+) {
+    src.clear();
+    src.resize(keep, 0);
+    for (i, &d) in dest.iter().enumerate() {
+        if (d as usize) < keep {
+            src[d as usize] = i as u32;
+        }
+    }
+    for c in starts.windows(2) {
+        let cell = &mut src[c[0] as usize..c[1] as usize];
+        // Insertion sort: a cell holds a few particles, mostly in order already from the last step.
+        for a in 1..cell.len() {
+            let mut b = a;
+            while b > 0 && key(cell[b - 1] as usize) > key(cell[b] as usize) {
+                cell.swap(b - 1, b);
+                b -= 1;
+            }
+        }
+    }
+    for (slot, &i) in src.iter().enumerate() {
+        dest[i as usize] = slot as u32;
+    }
 }
 
 /// Applies the permutation `dest` (from [`counting_sort`]) to `v`, using `scratch`, keeping the first `keep`.

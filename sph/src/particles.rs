@@ -2,7 +2,11 @@
 //! velocities relative to the tank frame, densities); the interaction loops read f32 copies refreshed before
 //! each force evaluation, in the same cell-sorted order.
 
-use crate::neighbours::{counting_sort, permute, Grid, OUTSIDE};
+use crate::neighbours::{counting_sort, order_cells_by, permute, Grid, OUTSIDE};
+
+/// Marks the id of a halo particle: a copy of a particle owned by the neighbouring subdomain (MPI runs), kept
+/// for its neighbours' sums and left out of every total.
+pub const HALO: u32 = 1 << 31;
 
 /// The liquid.
 #[derive(Clone, Debug)]
@@ -20,7 +24,8 @@ pub struct Fluid<const D: usize> {
     pub pressure: Vec<f64>,
     pub kappa: Vec<f64>,
     pub kappa_div: Vec<f64>,
-    /// Original index of each particle (stable through sorting).
+    /// Original index of each particle (stable through sorting; orders the particles inside a cell), with
+    /// [`HALO`] set on halo copies.
     pub id: Vec<u32>,
     // Interaction copies (f32) and cell of each particle, refreshed every force evaluation.
     pub x: [Vec<f32>; D],
@@ -44,6 +49,7 @@ pub struct SortScratch {
     f64s: Vec<f64>,
     f32s: Vec<f32>,
     u32s: Vec<u32>,
+    order: Vec<u32>,
 }
 
 fn vecs<T, const D: usize>() -> [Vec<T>; D] {
@@ -124,6 +130,12 @@ impl<const D: usize> Fluid<D> {
         std::array::from_fn(|k| self.pos[k][i])
     }
 
+    /// Whether particle i belongs here (not a halo copy).
+    #[inline]
+    pub fn owned(&self, i: usize) -> bool {
+        self.id[i] & HALO == 0
+    }
+
     /// Sorts all per-particle arrays by cell and drops particles that left the grid. Returns how many left.
     pub fn sort(&mut self, grid: &Grid<D>, scratch: &mut SortScratch) -> usize {
         let n = self.len();
@@ -136,6 +148,14 @@ impl<const D: usize> Fluid<D> {
             &self.cell,
             &mut self.starts,
             &mut scratch.dest,
+        );
+        let id = &self.id;
+        order_cells_by(
+            |i| id[i] & !HALO,
+            &self.starts,
+            &mut scratch.dest,
+            &mut scratch.order,
+            keep,
         );
         let dest = &scratch.dest;
         let s = &mut scratch.f64s;

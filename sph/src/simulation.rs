@@ -5,6 +5,7 @@
 //! the tank is in the world, and positions keep their precision relative to the tank origin.
 
 use crate::boundary::{dynamic, mirror};
+use crate::domain::{Comm, Domain, Op};
 use crate::eos::Tait;
 use crate::error::SimError;
 use crate::integrate;
@@ -20,6 +21,12 @@ use crate::scheme::dfsph;
 use crate::scheme::wcsph::{self, Coefficients};
 use crate::scheme::{FrameTerms, PassTotals};
 use crate::tank::{fluid_lattice, from3, to3, wall_lattice, TankBox};
+use std::sync::Arc;
+
+/// Subdomains are rebalanced (if the largest holds more than `1 + REBALANCE_TOLERANCE` times the mean
+/// count) at the start of every `REBALANCE_EVERY`th step.
+const REBALANCE_EVERY: u64 = 20;
+const REBALANCE_TOLERANCE: f64 = 0.1;
 
 /// Particle counts.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -77,10 +84,18 @@ pub struct Simulation<const D: usize, K: Kernel> {
     /// last observation, and their duration (the observed wrench is their mean).
     impulse: PassTotals,
     impulse_time: f64,
+    /// This rank's part of a decomposition over several processes (MPI), if any.
+    dom: Option<Domain>,
 }
 
 impl<const D: usize, K: Kernel> Simulation<D, K> {
     pub fn new(params: SimParams) -> Result<Self, SimError> {
+        Self::new_in(params, None)
+    }
+
+    /// This rank's part of the simulation decomposed over `comm`'s ranks (see [`crate::domain`]); serial
+    /// without `comm` or with a single rank.
+    pub fn new_in(params: SimParams, comm: Option<Arc<dyn Comm>>) -> Result<Self, SimError> {
         params.validate()?;
         assert_eq!(params.dimension, D, "dimension mismatch");
         let dp = params.particle_spacing;
@@ -128,6 +143,19 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             volume: shell_volume as f32,
         };
         shell.points.sort(&grid, &mut scratch);
+        let rho_rest = {
+            let m_bound = (rho0 * wall_volume) as f32;
+            rest_density(&kernel, &fluid, &bound, m_fluid as f32, m_bound) as f32
+        };
+        let dom = match comm.filter(|c| c.size() > 1) {
+            None => None,
+            Some(_) if params.solver.scheme == Scheme::Dfsph => {
+                return Err(SimError::Decomposition(
+                    "solver.scheme dfsph does not run across MPI ranks yet: run it in one process, or set solver.scheme wcsph for mpirun".into(),
+                ))
+            }
+            Some(c) => Some(Domain::split(c, &grid, &mut fluid).map_err(SimError::Decomposition)?),
+        };
         fluid.sort(&grid, &mut scratch);
 
         let s = &params.solver;
@@ -155,7 +183,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         };
         let dcoef = dfsph::Coefficients {
             pair: coef,
-            rho_rest: rest_density(&kernel, &fluid, &bound, coef.m_fluid, coef.m_bound) as f32,
+            rho_rest,
             full_neighbourhood: {
                 let q = support / dp;
                 let full = if D == 2 {
@@ -196,6 +224,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             dwork: Default::default(),
             impulse: PassTotals::default(),
             impulse_time: 0.0,
+            dom,
         })
     }
 
@@ -284,21 +313,76 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         Ok(r)
     }
 
-    /// The frame terms of the motion at t.
+    /// The frame terms of the motion at t (across ranks: rank 0's motion, broadcast).
     fn frame(&self, motion: &dyn TankMotion, t: f64) -> FrameTerms {
-        let s = motion.state(t);
-        let f = |v: nalgebra::Vector3<f64>| [v.x as f32, v.y as f32, v.z as f32];
+        let local = || {
+            let s = motion.state(t);
+            let f = |v: nalgebra::Vector3<f64>| [v.x as f32, v.y as f32, v.z as f32];
+            FrameTerms {
+                g: f(s.apparent_gravity(self.params.gravity)),
+                w: f(s.angular_velocity),
+                dw: f(s.angular_acceleration),
+            }
+        };
+        let Some(dom) = &self.dom else {
+            return local();
+        };
+        let mut buf = Vec::new();
+        if dom.is_root() {
+            let f = local();
+            buf.extend(f.g.iter().chain(&f.w).chain(&f.dw).map(|&v| v as f64));
+        }
+        dom.comm.broadcast(&mut buf);
+        let v = |k: usize| std::array::from_fn(|d| buf[3 * k + d] as f32);
         FrameTerms {
-            g: f(s.apparent_gravity(self.params.gravity)),
-            w: f(s.angular_velocity),
-            dw: f(s.angular_acceleration),
+            g: v(0),
+            w: v(1),
+            dw: v(2),
+        }
+    }
+
+    /// When the motion ends (across ranks: rank 0's motion's end).
+    fn end_time(&self, motion: &dyn TankMotion) -> f64 {
+        match &self.dom {
+            None => motion.end_time(),
+            Some(dom) => {
+                let mut buf = Vec::new();
+                if dom.is_root() {
+                    buf.push(motion.end_time());
+                }
+                dom.comm.broadcast(&mut buf);
+                buf[0]
+            }
         }
     }
 
     /// Evaluates the rates at time t for the current state. `sort` re-bins the liquid first (once a step).
     fn evaluate(&mut self, motion: &dyn TankMotion, t: f64, sort: bool) -> Result<(), SimError> {
         let frame = self.frame(motion, t);
-        if sort {
+        let walls = self.params.solver.boundary.method == BoundaryMethod::Dynamic;
+        if let Some(dom) = &mut self.dom {
+            // Across ranks: where a serial run sorts (the start of a step), particles move to their slab's
+            // rank, the halos are rebuilt and the slabs rebalanced now and then; in the middle of a step
+            // the halo copies are only brought up to date.
+            let walls = walls.then_some(&mut self.bound);
+            if sort {
+                let rebalance = self
+                    .stats
+                    .steps
+                    .is_multiple_of(REBALANCE_EVERY)
+                    .then_some(REBALANCE_TOLERANCE);
+                let lost = dom.exchange(&self.grid, &mut self.fluid, walls, rebalance);
+                self.fluid.sort(&self.grid, &mut self.scratch);
+                dom.index_halos(&self.grid, &self.fluid);
+                self.lost += lost;
+                dom.count(&self.fluid, self.lost);
+                if dom.fluid_total == 0 {
+                    return Err(SimError::AllParticlesLost { time: t });
+                }
+            } else {
+                dom.refresh(&self.grid, &mut self.fluid, walls);
+            }
+        } else if sort {
             self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
             if self.fluid.is_empty() {
                 return Err(SimError::AllParticlesLost { time: t });
@@ -330,7 +414,23 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             &self.bound,
             &mut self.work,
         );
-        if self.params.solver.boundary.method == BoundaryMethod::Dynamic {
+        if let Some(dom) = &self.dom {
+            let l = &mut self.last;
+            let mut v = [
+                l.force[0],
+                l.force[1],
+                l.force[2],
+                l.moment[0],
+                l.moment[1],
+                l.moment[2],
+                f64::from(u8::from(l.non_finite)),
+            ];
+            dom.comm.reduce(&mut v, Op::Sum);
+            l.force = [v[0], v[1], v[2]];
+            l.moment = [v[3], v[4], v[5]];
+            l.non_finite = v[6] > 0.0;
+        }
+        if walls {
             wcsph::wall_density_rates(
                 &self.kernel,
                 &self.coef,
@@ -354,13 +454,23 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let s = &self.params.solver;
         let h = self.coef.h as f64;
         let rmax = self.fluid.r.iter().fold(self.coef.rho0, |m, &r| m.max(r));
-        let cmax = self.eos.sound_speed(rmax) as f64;
-        let dt_f = if self.last.max_acc > 0.0 {
-            (h / self.last.max_acc as f64).sqrt()
+        let mut max = [
+            rmax as f64,
+            self.last.max_acc as f64,
+            self.last.max_mu as f64,
+        ];
+        if let Some(dom) = &self.dom {
+            // The maxima over all ranks (not the least of each rank's step: c and μ add up).
+            dom.comm.reduce(&mut max, Op::Max);
+        }
+        let [rmax, max_acc, max_mu] = max;
+        let cmax = self.eos.sound_speed(rmax as f32) as f64;
+        let dt_f = if max_acc > 0.0 {
+            (h / max_acc).sqrt()
         } else {
             f64::INFINITY
         };
-        let dt_cv = h / (cmax + self.last.max_mu as f64);
+        let dt_cv = h / (cmax + max_mu);
         let mut dt = s.cfl * dt_f.min(dt_cv);
         if s.laminar_viscosity {
             dt = dt.min(0.125 * h * h / self.params.fluid.kinematic_viscosity);
@@ -395,15 +505,13 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         }
         self.rates_current = false;
         let mut dt = self.time_step()?;
+        let end = self.end_time(motion);
         // The last step before the motion ends lands on its end (a shorter step is always stable).
-        if t < motion.end_time() && t + dt > motion.end_time() {
-            dt = motion.end_time() - t;
+        if t < end && t + dt > end {
+            dt = end - t;
         }
-        if t + dt > motion.end_time() + 1e-12 {
-            return Err(SimError::MotionEnded {
-                time: t + dt,
-                end: motion.end_time(),
-            });
+        if t + dt > end + 1e-12 {
+            return Err(SimError::MotionEnded { time: t + dt, end });
         }
         let walls = self.params.solver.boundary.method == BoundaryMethod::Dynamic;
         match self.params.solver.integrator {
@@ -473,11 +581,17 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let m = self.coef.m_fluid;
         let dp = self.params.particle_spacing;
         let top = self.params.tank.height;
-        let probes = self
+        // Across ranks, each probe and sensor is read by the rank whose slab holds it (its halo holds all
+        // the liquid in reach), the others add zero.
+        let mine = |x: f64| self.dom.as_ref().is_none_or(|d| d.owns(&self.grid, x));
+        let mut probes: Vec<f64> = self
             .params
             .probes
             .iter()
             .map(|p| {
+                if !mine(p.x) {
+                    return 0.0;
+                }
                 probes::elevation(
                     k,
                     &self.grid,
@@ -491,11 +605,14 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             })
             .collect();
         let dfsph = self.params.solver.scheme == Scheme::Dfsph;
-        let pressures = self
+        let mut pressures: Vec<f64> = self
             .params
             .pressure_sensors
             .iter()
             .map(|s| {
+                if !mine(s.x) {
+                    return 0.0;
+                }
                 let at: [f64; D] = from3([s.x, s.y, s.z]);
                 match wall_pressure::face_of(&self.tank, at, 0.5 * dp) {
                     Some(face) if dfsph => {
@@ -519,6 +636,13 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 }
             })
             .collect();
+        if let Some(dom) = &self.dom {
+            let np = probes.len();
+            let mut v: Vec<f64> = probes.iter().chain(&pressures).copied().collect();
+            dom.comm.reduce(&mut v, Op::Sum);
+            probes.copy_from_slice(&v[..np]);
+            pressures.copy_from_slice(&v[np..]);
+        }
         // The boundary's force on the liquid, reversed; a 2D result stands for the tank's breadth.
         let scale = if D == 2 {
             -self.params.tank.breadth
@@ -560,11 +684,30 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     }
 
     pub fn counts(&self) -> Counts {
-        Counts {
-            fluid: self.fluid.len(),
-            boundary: self.bound.len(),
-            lost: self.lost,
+        match &self.dom {
+            None => Counts {
+                fluid: self.fluid.len(),
+                boundary: self.bound.len(),
+                lost: self.lost,
+            },
+            // Totals of the last exchange; wall particles are the same on every rank (mirror ghosts: rank
+            // 0's).
+            Some(d) => Counts {
+                fluid: d.fluid_total,
+                boundary: self.bound.len(),
+                lost: d.lost_total,
+            },
         }
+    }
+
+    /// Ranks the simulation runs on.
+    pub fn ranks(&self) -> usize {
+        self.dom.as_ref().map_or(1, |d| d.comm.size())
+    }
+
+    /// Times the subdomains were moved to even out the particle counts.
+    pub fn rebalances(&self) -> u64 {
+        self.dom.as_ref().map_or(0, |d| d.rebalances)
     }
 
     pub fn params(&self) -> &SimParams {
@@ -573,7 +716,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     /// Mass of the liquid, kg (a 2D run: for the tank's breadth).
     pub fn liquid_mass(&self) -> f64 {
-        let m = self.fluid.len() as f64 * self.coef.m_fluid as f64;
+        let m = self.counts().fluid as f64 * self.coef.m_fluid as f64;
         if D == 2 {
             m * self.params.tank.breadth
         } else {
@@ -581,18 +724,35 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         }
     }
 
-    /// Liquid particle positions in the tank frame as x, y, z.
+    /// Liquid particle positions in the tank frame as x, y, z (across ranks: all of them on rank 0, in the
+    /// order of their ids, none elsewhere).
     pub fn fluid_positions(&self) -> Vec<[f64; 3]> {
-        (0..self.fluid.len())
-            .map(|i| to3(self.fluid.position(i)))
-            .collect()
+        self.fluid_field(|f, i| to3(f.position(i)))
     }
 
-    /// Liquid particle velocities relative to the tank as x, y, z.
+    /// Liquid particle velocities relative to the tank as x, y, z (across ranks as [`Self::fluid_positions`]).
     pub fn fluid_velocities(&self) -> Vec<[f64; 3]> {
-        (0..self.fluid.len())
-            .map(|i| to3(std::array::from_fn::<f64, D, _>(|k| self.fluid.vel[k][i])))
-            .collect()
+        self.fluid_field(|f, i| to3(std::array::from_fn::<f64, D, _>(|k| f.vel[k][i])))
+    }
+
+    fn fluid_field(&self, at: impl Fn(&Fluid<D>, usize) -> [f64; 3]) -> Vec<[f64; 3]> {
+        let f = &self.fluid;
+        let Some(dom) = &self.dom else {
+            return (0..f.len()).map(|i| at(f, i)).collect();
+        };
+        let mut local = Vec::new();
+        for i in (0..f.len()).filter(|&i| f.owned(i)) {
+            local.push(f.id[i] as f64);
+            local.extend(at(f, i));
+        }
+        let mut all: Vec<(u32, [f64; 3])> = dom
+            .gather(local)
+            .iter()
+            .flat_map(|v| v.chunks_exact(4))
+            .map(|r| (r[0] as u32, [r[1], r[2], r[3]]))
+            .collect();
+        all.sort_unstable_by_key(|r| r.0);
+        all.into_iter().map(|r| r.1).collect()
     }
 
     /// Every particle's position, velocity, pressure and density now, in the tank frame (changes nothing).
@@ -610,7 +770,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             density: Vec::with_capacity(nf + nb),
             id: Vec::with_capacity(nf + nb),
         };
-        for i in 0..nf {
+        for i in (0..nf).filter(|&i| f.owned(i)) {
             s.position.push(to3(std::array::from_fn::<f32, D, _>(|k| {
                 f.pos[k][i] as f32
             })));
@@ -626,6 +786,10 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             s.density.push(rho);
             s.id.push(f.id[i]);
         }
+        s.fluid = s.id.len();
+        if let Some(dom) = &self.dom {
+            return self.gather_snapshot(dom, s);
+        }
         for j in 0..nb {
             s.position
                 .push(to3(std::array::from_fn::<f32, D, _>(|k| b.x[k][j])));
@@ -636,6 +800,66 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 .push(if dfsph { 0.0 } else { self.eos.pressure(rho) });
             s.density
                 .push(if dfsph { self.dcoef.rho_rest } else { rho });
+            s.id.push(j as u32);
+        }
+        s
+    }
+
+    /// Rank 0: the liquid of every rank (in the order of the ids) and the walls with their owners'
+    /// densities. Other ranks send theirs and get an empty snapshot.
+    fn gather_snapshot(&self, dom: &Domain, mut s: Snapshot) -> Snapshot {
+        let (b, dfsph) = (&self.bound, false);
+        let mut local = Vec::with_capacity(s.fluid * 9 + 1);
+        local.push(s.fluid as f64);
+        for i in 0..s.fluid {
+            local.push(s.id[i] as f64);
+            local.extend(
+                s.position[i]
+                    .iter()
+                    .chain(&s.velocity[i])
+                    .map(|&v| v as f64),
+            );
+            local.extend([s.pressure[i] as f64, s.density[i] as f64]);
+        }
+        for j in 0..b.rho.len() {
+            if dom.owns(&self.grid, b.x[0][j] as f64) {
+                local.extend([j as f64, b.rho[j]]);
+            }
+        }
+        let all = dom.gather(local);
+        if !dom.is_root() {
+            return Snapshot::default();
+        }
+        let mut fluid: Vec<&[f64]> = Vec::new();
+        let mut wall_rho: Vec<f64> = b.rho.clone();
+        for msg in &all {
+            let n = msg[0] as usize;
+            fluid.extend(msg[1..1 + 9 * n].chunks_exact(9));
+            for p in msg[1 + 9 * n..].chunks_exact(2) {
+                wall_rho[p[0] as usize] = p[1];
+            }
+        }
+        fluid.sort_unstable_by(|a, b| a[0].total_cmp(&b[0]));
+        let f32s = |r: &[f64]| -> [f32; 3] { [r[0] as f32, r[1] as f32, r[2] as f32] };
+        s = Snapshot {
+            time: s.time,
+            dimension: D,
+            fluid: fluid.len(),
+            id: fluid.iter().map(|r| r[0] as u32).collect(),
+            position: fluid.iter().map(|r| f32s(&r[1..4])).collect(),
+            velocity: fluid.iter().map(|r| f32s(&r[4..7])).collect(),
+            pressure: fluid.iter().map(|r| r[7] as f32).collect(),
+            density: fluid.iter().map(|r| r[8] as f32).collect(),
+        };
+        for j in 0..b.len() {
+            s.position
+                .push(to3(std::array::from_fn::<f32, D, _>(|k| b.x[k][j])));
+            s.velocity
+                .push(to3(std::array::from_fn::<f32, D, _>(|k| b.v[k][j])));
+            let rho = wall_rho.get(j).map_or(self.eos.rho0, |&r| r as f32);
+            s.pressure
+                .push(if dfsph { 0.0 } else { self.eos.pressure(rho) });
+            s.density.push(rho);
             s.id.push(j as u32);
         }
         s
@@ -709,6 +933,10 @@ pub trait Solver: Send {
     fn fluid_velocities(&self) -> Vec<[f64; 3]>;
     fn set_fluid_velocity(&mut self, f: &dyn Fn([f64; 3]) -> [f64; 3]);
     fn snapshot(&self) -> Snapshot;
+    /// Ranks (processes) the simulation is spread over.
+    fn ranks(&self) -> usize;
+    /// Times the subdomains were moved to even out the particle counts.
+    fn rebalances(&self) -> u64;
 }
 
 impl<const D: usize, K: Kernel> Solver for Simulation<D, K> {
@@ -748,17 +976,45 @@ impl<const D: usize, K: Kernel> Solver for Simulation<D, K> {
     fn snapshot(&self) -> Snapshot {
         Simulation::snapshot(self)
     }
+    fn ranks(&self) -> usize {
+        Simulation::ranks(self)
+    }
+    fn rebalances(&self) -> u64 {
+        Simulation::rebalances(self)
+    }
 }
 
-/// Builds the simulation the parameters ask for.
+/// Builds the simulation the parameters ask for: in one process, or spread over the ranks of an MPI
+/// program ([`crate::domain::install`]; called on rank 0, the others follow in [`crate::domain::serve`]).
 pub fn build(params: SimParams) -> Result<Box<dyn Solver>, SimError> {
+    params.validate()?;
+    match crate::domain::world() {
+        Some(comm) => Ok(Box::new(crate::domain::Distributed::build(
+            comm.clone(),
+            params,
+        )?)),
+        None => build_local(params, None),
+    }
+}
+
+/// This process's simulation (its part of one decomposed over `comm`).
+pub(crate) fn build_local(
+    params: SimParams,
+    comm: Option<Arc<dyn Comm>>,
+) -> Result<Box<dyn Solver>, SimError> {
     use crate::kernel::{CubicSpline, KernelKind, WendlandC2};
     params.validate()?;
     Ok(match (params.dimension, params.solver.kernel) {
-        (2, KernelKind::CubicSpline) => Box::new(Simulation::<2, CubicSpline>::new(params)?),
-        (2, KernelKind::Wendland) => Box::new(Simulation::<2, WendlandC2>::new(params)?),
-        (3, KernelKind::CubicSpline) => Box::new(Simulation::<3, CubicSpline>::new(params)?),
-        (_, KernelKind::Wendland) => Box::new(Simulation::<3, WendlandC2>::new(params)?),
-        (_, KernelKind::CubicSpline) => Box::new(Simulation::<3, CubicSpline>::new(params)?),
+        (2, KernelKind::CubicSpline) => {
+            Box::new(Simulation::<2, CubicSpline>::new_in(params, comm)?)
+        }
+        (2, KernelKind::Wendland) => Box::new(Simulation::<2, WendlandC2>::new_in(params, comm)?),
+        (3, KernelKind::CubicSpline) => {
+            Box::new(Simulation::<3, CubicSpline>::new_in(params, comm)?)
+        }
+        (_, KernelKind::Wendland) => Box::new(Simulation::<3, WendlandC2>::new_in(params, comm)?),
+        (_, KernelKind::CubicSpline) => {
+            Box::new(Simulation::<3, CubicSpline>::new_in(params, comm)?)
+        }
     })
 }

@@ -10,7 +10,7 @@ use super::{FrameTerms, PassTotals, CHUNK};
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DiffusionKind;
-use crate::particles::{Boundary, Fluid};
+use crate::particles::{Boundary, Fluid, HALO};
 use crate::tank::{cross, from3, to3};
 use rayon::prelude::*;
 
@@ -220,6 +220,8 @@ struct Pass<'a, const D: usize, K> {
     pr2: &'a [f32],
     cell: &'a [u32],
     starts: &'a [u32],
+    /// Ids: halo copies ([`HALO`]) get rates (unused) but stay out of the totals.
+    id: &'a [u32],
     bound: &'a Boundary<D>,
     /// Run the pair loop with AVX2 + FMA ([`wide_lanes`]).
     wide: bool,
@@ -273,6 +275,9 @@ fn chunk<const D: usize, K: Kernel>(
             a2 += acc_a[d] * acc_a[d];
         }
         *drho_a = out.drho;
+        if p.id[a] & HALO != 0 {
+            continue;
+        }
         if !(a2.is_finite() && out.drho.is_finite()) {
             tot.non_finite = true;
         }
@@ -307,6 +312,7 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
         starts,
         acc,
         drho,
+        id,
         ..
     } = fluid;
     let pass = Pass {
@@ -321,6 +327,7 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
         pr2,
         cell,
         starts,
+        id,
         bound,
         wide: wide_lanes(),
     };
