@@ -1,1 +1,220 @@
-//! placeholder
+//! `mpirun -n N slosh ...` (OpenMPI; built with `--features mpi`): the liquid decomposed over ranks gives
+//! the serial run's outputs, conserves the particles, reports its world size, and fails as one program.
+
+mod common;
+
+use common::{csv, mpirun, slosh};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const CASE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../launch-configs/seed_tank_019.yaml"
+);
+
+/// `slosh run CASE --out OUT args...` by `cmd` (plain or under mpirun).
+fn run(mut cmd: Command, out: &Path, args: &[&str]) -> Output {
+    let o = cmd
+        .args(["run", CASE, "--out"])
+        .arg(out)
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success() || args.contains(&"solver.dt_min=1.0"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn summary(out: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+/// Asserts that two runs' CSV files agree: the same times and columns, values within `tol` times the
+/// column's largest magnitude (CSV values carry 7 significant digits).
+fn same_csv(a: &Path, b: &Path, tol: f64) {
+    let (ha, ra) = csv(a);
+    let (hb, rb) = csv(b);
+    assert_eq!(ha, hb);
+    assert_eq!(ra.len(), rb.len(), "{} rows", b.display());
+    for c in 0..ha.len() {
+        let scale = ra.iter().map(|r| r[c].abs()).fold(1e-12, f64::max);
+        for (x, y) in ra.iter().zip(&rb) {
+            assert!(
+                (x[c] - y[c]).abs() <= tol * scale,
+                "{} column {} at t = {}: {} serial, {} across ranks",
+                b.display(),
+                ha[c],
+                x[0],
+                x[c],
+                y[c]
+            );
+        }
+    }
+}
+
+fn tmp(name: &str) -> PathBuf {
+    common::tmp(&format!("mpi-{name}"))
+}
+
+/// Sloshing in the seed tank (2D, the irregular motion of the case, ramped up in 0.2 s) on 1, 2 and 3
+/// ranks: the decomposition reproduces the serial run (probes and sensors exactly, the wrench up to the
+/// order of its sums), keeps every particle and its mass, rebalances the slabs as the liquid moves, and
+/// says on how many ranks it ran.
+#[test]
+fn sloshing_on_one_two_and_three_ranks_equals_the_serial_run() {
+    let dir = tmp("2d");
+    let args = [
+        "--duration",
+        "1.5",
+        "--set",
+        "dimension=2",
+        "--set",
+        "particle_spacing=0.02",
+        "--set",
+        "motion.ramp_time=0.2",
+    ];
+    let serial = dir.join("serial");
+    run(slosh(), &serial, &args);
+    let s = summary(&serial);
+    assert_eq!(s["mpi_ranks"], 1);
+    // The motion must move the liquid for the comparison to mean something.
+    let (_, probes) = csv(&serial.join("probes.csv"));
+    let swing = probes.iter().map(|r| r[1]).fold(f64::MIN, f64::max)
+        - probes.iter().map(|r| r[1]).fold(f64::MAX, f64::min);
+    assert!(swing > 0.02, "the probe near the wall moved {swing} m");
+    for ranks in 1..=3 {
+        let out = dir.join(format!("ranks{ranks}"));
+        let o = run(mpirun(ranks), &out, &args);
+        let m = summary(&out);
+        // The world size: a binary started by another launcher would be `ranks` serial runs of 1.
+        assert_eq!(
+            m["mpi_ranks"],
+            ranks,
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        for k in [
+            "particles_fluid",
+            "particles_boundary",
+            "particles_lost",
+            "liquid_mass_kg",
+            "steps",
+            "sim_time_s",
+        ] {
+            assert_eq!(m[k], s[k], "{k} on {ranks} ranks");
+        }
+        same_csv(&serial.join("probes.csv"), &out.join("probes.csv"), 0.0);
+        same_csv(&serial.join("pressure.csv"), &out.join("pressure.csv"), 0.0);
+        same_csv(&serial.join("wrench.csv"), &out.join("wrench.csv"), 1e-6);
+        if ranks == 3 {
+            assert!(
+                m["rebalances"].as_u64().unwrap() > 0,
+                "the liquid moved from wall to wall but the slabs never followed: {m}"
+            );
+        }
+        // Only rank 0 wrote (one progress line per run, not one per rank).
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(err.matches("slosh: running").count(), 1, "{err}");
+    }
+}
+
+/// 3D: the seed tank on 2 ranks against the serial run.
+#[test]
+fn three_dimensional_tank_on_two_ranks_equals_the_serial_run() {
+    let dir = tmp("3d");
+    let args = [
+        "--duration",
+        "0.4",
+        "--set",
+        "particle_spacing=0.04",
+        "--set",
+        "motion.ramp_time=0.1",
+    ];
+    let serial = dir.join("serial");
+    run(slosh(), &serial, &args);
+    let out = dir.join("ranks2");
+    run(mpirun(2), &out, &args);
+    let (s, m) = (summary(&serial), summary(&out));
+    assert_eq!(s["dimension"], 3);
+    assert_eq!(m["mpi_ranks"], 2);
+    for k in [
+        "particles_fluid",
+        "particles_lost",
+        "steps",
+        "liquid_mass_kg",
+    ] {
+        assert_eq!(m[k], s[k], "{k}");
+    }
+    same_csv(&serial.join("probes.csv"), &out.join("probes.csv"), 0.0);
+    same_csv(&serial.join("wrench.csv"), &out.join("wrench.csv"), 1e-6);
+}
+
+/// A failure on the ranks (here the time step collapsing at once) stops every rank; rank 0 reports it
+/// once and finishes the outputs. Settings the decomposition cannot take are refused by name.
+#[test]
+fn a_failure_stops_all_ranks_and_is_reported_once() {
+    let dir = tmp("fail");
+    let out = dir.join("collapse");
+    let o = run(
+        mpirun(2),
+        &out,
+        &[
+            "--duration",
+            "0.2",
+            "--set",
+            "dimension=2",
+            "--set",
+            "particle_spacing=0.02",
+            "--set",
+            "solver.dt_min=1.0",
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert_eq!(err.matches("time step collapsed").count(), 1, "{err}");
+    let s = summary(&out);
+    assert!(
+        s["error"].as_str().unwrap().contains("time step collapsed"),
+        "{s}"
+    );
+    assert_eq!(s["mpi_ranks"], 2);
+    // The first output row (t = 0) was written before the failure and the files were finished.
+    assert_eq!(csv(&out.join("probes.csv")).1.len(), 1);
+
+    let o = mpirun(2)
+        .args(["run", CASE, "--out"])
+        .arg(dir.join("dfsph"))
+        .args(["--duration", "0.1", "--set", "solver.scheme=dfsph"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("solver.scheme dfsph does not run across MPI ranks"),
+        "{err}"
+    );
+
+    // A 0.12 m tank is 14 neighbour-grid columns long with its walls: at most 7 slabs of 2 columns.
+    let o = mpirun(8)
+        .args(["run", CASE, "--out"])
+        .arg(dir.join("narrow"))
+        .args(["--duration", "0.1", "--set", "dimension=2"])
+        .args([
+            "--set",
+            "tank.length=0.12",
+            "--set",
+            "particle_spacing=0.02",
+        ])
+        .args(["--set", "probes.x=[0.0,0.01]"])
+        .args(["--set", "pressure_sensors.x=[-0.06,0.06]"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("run on at most 7 ranks"), "{err}");
+}

@@ -347,3 +347,46 @@ fn rate_caps_the_replay_speed_and_the_motion_bounds_the_duration() {
     );
     assert!(!ok && err.contains("cannot be used with"), "{err}");
 }
+
+/// `mpirun -n 2 slosh replay`: rank 0 alone reads the bag and writes the outputs and the new recording;
+/// they equal the serial replay's, and third-party readers read the recording.
+#[cfg(feature = "mpi")]
+#[test]
+fn replay_on_two_mpi_ranks_equals_the_serial_replay() {
+    let (dir, case) = setup("replay-mpi", 1.2);
+    let bag = write_bag(&dir, "odom_bag", &["--type", "odom"]);
+    let serial = dir.join("serial");
+    let (ok, err) = replay(&bag, &case, &serial, &["--duration", "1.0"]);
+    assert!(ok, "{err}");
+    let out = dir.join("ranks2");
+    let o = common::mpirun(2)
+        .arg("replay")
+        .arg(&bag)
+        .arg("--config")
+        .arg(&case)
+        .arg("--out")
+        .arg(&out)
+        .args(["--duration", "1.0"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(summary(&out)["mpi_ranks"], 2);
+    for f in ["probes.csv", "pressure.csv"] {
+        assert_eq!(csv(&out.join(f)), csv(&serial.join(f)), "{f}");
+    }
+    let (w, sw) = (
+        csv(&out.join("wrench.csv")).1,
+        csv(&serial.join("wrench.csv")).1,
+    );
+    assert_eq!(w.len(), sw.len());
+    for (a, b) in w.iter().zip(&sw) {
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-6 * (1.0 + y.abs()), "{a:?} vs {b:?}");
+        }
+    }
+    let v = common::read_bag(&out.join("bag"));
+    for reader in ["rosbags", "mcap"] {
+        let items = v[reader]["/probes"]["items"].as_array().unwrap();
+        assert_eq!(items.len(), w.len(), "{reader}");
+    }
+}

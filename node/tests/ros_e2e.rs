@@ -78,6 +78,15 @@ fn motion_to_node_to_subscriber_matches_slosh_run() {
     }
 }
 
+/// `mpirun -n 2 slosh node`: rank 0 alone talks to ROS 2 and records; its outputs match the serial `slosh run`.
+#[cfg(feature = "mpi")]
+#[test]
+fn node_on_two_mpi_ranks_matches_slosh_run() {
+    if common::in_private_netns("node_on_two_mpi_ranks_matches_slosh_run") {
+        compare_with_run_on("odom", 23, 2);
+    }
+}
+
 #[test]
 fn imu_driven_node_matches_slosh_run() {
     if common::in_private_netns("imu_driven_node_matches_slosh_run") {
@@ -94,7 +103,12 @@ fn odom_with_measured_accelerations_matches_slosh_run() {
 
 /// `slosh motion` → `slosh node` (input `kind`: odom, imu, or accel = odom + AccelStamped) → this subscriber, against `slosh run` on the same motion.
 fn compare_with_run(kind: &str, domain_id: u16) {
-    let dir = common::tmp(&format!("ros-e2e-{kind}"));
+    compare_with_run_on(kind, domain_id, 1)
+}
+
+/// As [`compare_with_run`], the node started by `mpirun -n ranks` when `ranks` > 1.
+fn compare_with_run_on(kind: &str, domain_id: u16, ranks: usize) {
+    let dir = common::tmp(&format!("ros-e2e-{kind}-{ranks}"));
     let case = dir.join("case.yaml");
     std::fs::write(&case, common::small_case(EXTRA)).unwrap();
     let domain = domain_id.to_string();
@@ -107,35 +121,39 @@ fn compare_with_run(kind: &str, domain_id: u16) {
     let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
 
     let node_proc = Kill(
-        slosh()
-            .args([
-                "node",
-                "--duration",
-                &DURATION.to_string(),
-                "--ros-args",
-                "--params-file",
-            ])
-            .arg(&case)
-            .args([
-                "-r",
-                "__ns:=/ship1",
-                "-r",
-                "__node:=tank2",
-                "-p",
-                "realtime.mode:=lockstep",
-            ])
-            .args(["-p", &format!("record.path:={}", dir.join("bag").display())])
-            .args(["-p", "particles.rate_hz:=5.0"])
-            .args(match kind {
-                "accel" => ["-p", "input.accel:=true"],
-                "imu" => ["-p", "input.type:=imu"],
-                _ => ["-p", "input.type:=odom"],
-            })
-            .env("ROS_DOMAIN_ID", domain)
-            .stdout(Stdio::inherit())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap(),
+        if ranks > 1 {
+            common::mpirun(ranks)
+        } else {
+            slosh()
+        }
+        .args([
+            "node",
+            "--duration",
+            &DURATION.to_string(),
+            "--ros-args",
+            "--params-file",
+        ])
+        .arg(&case)
+        .args([
+            "-r",
+            "__ns:=/ship1",
+            "-r",
+            "__node:=tank2",
+            "-p",
+            "realtime.mode:=lockstep",
+        ])
+        .args(["-p", &format!("record.path:={}", dir.join("bag").display())])
+        .args(["-p", "particles.rate_hz:=5.0"])
+        .args(match kind {
+            "accel" => ["-p", "input.accel:=true"],
+            "imu" => ["-p", "input.type:=imu"],
+            _ => ["-p", "input.type:=odom"],
+        })
+        .env("ROS_DOMAIN_ID", domain)
+        .stdout(Stdio::inherit())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap(),
     );
     // Start the motion once this subscriber has discovered the node's outputs, so none of them is missed.
     let seen = Instant::now();

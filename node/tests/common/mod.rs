@@ -152,3 +152,18 @@ pub fn csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {
         .collect();
     (header, rows)
 }
+
+/// `mpirun -n RANKS slosh` (OpenMPI), kept on this machine: shared memory between ranks, loopback for the
+/// launcher, more ranks than cores allowed, and allowed as root (CI runs as root).
+pub fn mpirun(ranks: usize) -> Command {
+    let mut c = Command::new("mpirun");
+    c.args(["-n", &ranks.to_string()])
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        .env("OMPI_MCA_btl", "self,vader")
+        .env("OMPI_MCA_btl_tcp_if_include", "lo")
+        .env("OMPI_MCA_oob_tcp_if_include", "lo")
+        .arg(env!("CARGO_BIN_EXE_slosh"));
+    c
+}
