@@ -57,7 +57,9 @@ pub const CASES: &[Case] = &[
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchResult {
     pub case: String,
+    /// Threads per rank, and MPI ranks (1 without mpirun).
     pub threads: usize,
+    pub ranks: usize,
     pub particles_fluid: usize,
     pub particles_boundary: usize,
     pub steps: u64,
@@ -72,6 +74,10 @@ pub struct BenchResult {
     /// (incompressible scheme; `solver.dfsph.target_iterations`).
     pub unconverged_steps: u64,
     pub retried_steps: u64,
+    /// Across ranks: particle-steps per second per rank, and the share of rank 0's time spent in MPI calls
+    /// (communication and waiting for the other ranks).
+    pub particle_steps_per_s_per_rank: f64,
+    pub comm_share: f64,
 }
 
 /// Runs one case for `duration` simulated seconds (setup excluded from the timing), with `set` (KEY=VALUE)
@@ -89,12 +95,16 @@ pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::R
     let mut sim = sph::build(params)?;
     let duration = duration.unwrap_or(case.duration);
     let start = Instant::now();
+    let comm0 = sph::domain::comm_seconds();
     sim.advance_to(motion.as_ref(), duration)?;
     let wall = start.elapsed().as_secs_f64();
+    let comm = sph::domain::comm_seconds() - comm0;
+    let pst = sim.stats().steps as f64 * sim.counts().fluid as f64 / wall;
     let (stats, counts) = (sim.stats(), sim.counts());
     Ok(BenchResult {
         case: case.name.to_string(),
         threads: rayon::current_num_threads(),
+        ranks: sim.ranks(),
         particles_fluid: counts.fluid,
         particles_boundary: counts.boundary,
         steps: stats.steps,
@@ -106,5 +116,7 @@ pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::R
         iterations_per_step: stats.solver_iterations as f64 / stats.steps.max(1) as f64,
         unconverged_steps: stats.unconverged_steps,
         retried_steps: stats.retried_steps,
+        particle_steps_per_s_per_rank: pst / sim.ranks() as f64,
+        comm_share: comm / wall,
     })
 }

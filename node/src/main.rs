@@ -581,8 +581,9 @@ fn main() -> anyhow::Result<()> {
             };
             if !json {
                 println!(
-                    "{:<22} {:>7} {:>9} {:>8} {:>8} {:>10} {:>14} {:>10} {:>12}",
+                    "{:<22} {:>5} {:>7} {:>9} {:>8} {:>8} {:>10} {:>14} {:>10} {:>12} {:>7}",
                     "case",
+                    "ranks",
                     "threads",
                     "particles",
                     "steps",
@@ -590,7 +591,8 @@ fn main() -> anyhow::Result<()> {
                     "wall s",
                     "particle-st/s",
                     "RT factor",
-                    "wall s/sim s"
+                    "wall s/sim s",
+                    "comm %"
                 );
             }
             for c in cases {
@@ -599,8 +601,9 @@ fn main() -> anyhow::Result<()> {
                     println!("{}", serde_json::to_string(&r)?);
                 } else {
                     println!(
-                        "{:<22} {:>7} {:>9} {:>8} {:>8.3} {:>10.2} {:>14.3e} {:>10.4} {:>12.1}",
+                        "{:<22} {:>5} {:>7} {:>9} {:>8} {:>8.3} {:>10.2} {:>14.3e} {:>10.4} {:>12.1} {:>7.1}",
                         r.case,
+                        r.ranks,
                         r.threads,
                         r.particles_fluid,
                         r.steps,
@@ -608,7 +611,8 @@ fn main() -> anyhow::Result<()> {
                         r.wall_time_s,
                         r.particle_steps_per_s,
                         r.realtime_factor,
-                        r.wall_s_per_sim_s
+                        r.wall_s_per_sim_s,
+                        100.0 * r.comm_share
                     );
                 }
             }

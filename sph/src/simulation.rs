@@ -437,6 +437,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 &self.grid,
                 &self.fluid,
                 &mut self.bound,
+                self.dom.as_ref().map(|d| d.slabs.columns(d.comm.rank())),
             );
         }
         self.stats.force_evaluations += 1;

@@ -24,8 +24,11 @@ mod service;
 mod slabs;
 
 pub use exchange::Domain;
-pub use service::{install, ranks, serve, shutdown, world, Distributed};
+pub use service::{comm_seconds, install, ranks, serve, shutdown, world, Distributed};
 pub use slabs::Slabs;
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 /// A reduction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,4 +49,53 @@ pub trait Comm: Send + Sync {
     fn reduce(&self, v: &mut [f64], op: Op);
     /// Sends `send[r]` to rank r; `recv[r]` gets what rank r sent here (`recv` is resized to the size).
     fn all_to_all(&self, send: &[Vec<f64>], recv: &mut Vec<Vec<f64>>);
+    /// Seconds spent in the calls so far, if counted ([`Timed`]).
+    fn seconds(&self) -> f64 {
+        0.0
+    }
+}
+
+/// A [`Comm`] that adds up the time spent in its calls: communication, and waiting for the other ranks
+/// (load imbalance shows here too).
+pub struct Timed<C> {
+    inner: C,
+    nanos: AtomicU64,
+}
+
+impl<C: Comm> Timed<C> {
+    pub fn new(inner: C) -> Self {
+        Self {
+            inner,
+            nanos: AtomicU64::new(0),
+        }
+    }
+
+    fn time<T>(&self, f: impl FnOnce(&C) -> T) -> T {
+        let start = Instant::now();
+        let r = f(&self.inner);
+        self.nanos
+            .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        r
+    }
+}
+
+impl<C: Comm> Comm for Timed<C> {
+    fn rank(&self) -> usize {
+        self.inner.rank()
+    }
+    fn size(&self) -> usize {
+        self.inner.size()
+    }
+    fn broadcast(&self, buf: &mut Vec<f64>) {
+        self.time(|c| c.broadcast(buf))
+    }
+    fn reduce(&self, v: &mut [f64], op: Op) {
+        self.time(|c| c.reduce(v, op))
+    }
+    fn all_to_all(&self, send: &[Vec<f64>], recv: &mut Vec<Vec<f64>>) {
+        self.time(|c| c.all_to_all(send, recv))
+    }
+    fn seconds(&self) -> f64 {
+        self.nanos.load(Ordering::Relaxed) as f64 * 1e-9
+    }
 }

@@ -118,7 +118,7 @@ pub fn start() -> Result<Role, String> {
     let ranks = world.size() as usize;
     let rank = world.rank();
     if ranks > 1 {
-        super::install(Arc::new(MpiComm { world }));
+        super::install(Arc::new(super::Timed::new(MpiComm { world })));
         if rank != 0 {
             super::serve();
             drop(universe);

@@ -26,6 +26,11 @@ pub fn world() -> Option<&'static Arc<dyn Comm>> {
     WORLD.get().filter(|c| c.size() > 1)
 }
 
+/// Seconds this rank has spent communicating and waiting for the others (0 without ranks).
+pub fn comm_seconds() -> f64 {
+    world().map_or(0.0, |c| c.seconds())
+}
+
 /// Number of ranks the simulations run on.
 pub fn ranks() -> usize {
     world().map_or(1, |c| c.size())

@@ -116,12 +116,12 @@ mod tests {
             assert!(lo <= c && c < hi);
             for r in s.halo_of(o, c).into_iter().flatten() {
                 let (rlo, rhi) = s.columns(r);
-                assert!(c >= rlo - REACH && c < rhi + REACH);
+                assert!(c >= rlo.saturating_sub(REACH) && c < rhi.saturating_add(REACH));
             }
             // Every rank within reach of c (other than the owner) is listed.
             for r in 0..4 {
                 let (rlo, rhi) = s.columns(r);
-                if r != o && c >= rlo - REACH && c < rhi + REACH {
+                if r != o && c >= rlo.saturating_sub(REACH) && c < rhi.saturating_add(REACH) {
                     assert!(s.halo_of(o, c).contains(&Some(r)), "column {c} rank {r}");
                 }
             }

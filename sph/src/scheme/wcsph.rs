@@ -220,7 +220,7 @@ struct Pass<'a, const D: usize, K> {
     pr2: &'a [f32],
     cell: &'a [u32],
     starts: &'a [u32],
-    /// Ids: halo copies ([`HALO`]) get rates (unused) but stay out of the totals.
+    /// Ids: halo copies ([`HALO`]) are skipped (zero rates, out of the totals).
     id: &'a [u32],
     bound: &'a Boundary<D>,
     /// Run the pair loop with AVX2 + FMA ([`wide_lanes`]).
@@ -243,6 +243,12 @@ fn chunk<const D: usize, K: Kernel>(
     let mut filled = u32::MAX;
     for (o, (acc_a, drho_a)) in acc.iter_mut().zip(drho.iter_mut()).enumerate() {
         let a = first + o;
+        if p.id[a] & HALO != 0 {
+            // A halo copy: its owner computes its rates.
+            *acc_a = [0.0; D];
+            *drho_a = 0.0;
+            continue;
+        }
         if p.cell[a] != filled {
             // Particles are sorted by cell: the candidates change only when the cell does.
             filled = p.cell[a];
@@ -275,9 +281,6 @@ fn chunk<const D: usize, K: Kernel>(
             a2 += acc_a[d] * acc_a[d];
         }
         *drho_a = out.drho;
-        if p.id[a] & HALO != 0 {
-            continue;
-        }
         if !(a2.is_finite() && out.drho.is_finite()) {
             tot.non_finite = true;
         }
@@ -346,13 +349,15 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
     total
 }
 
-/// Density rate of dynamic wall particles by continuity with the liquid (walls at rest in the tank frame).
+/// Density rate of dynamic wall particles by continuity with the liquid (walls at rest in the tank frame);
+/// with `columns`, only of the walls in those grid columns (a subdomain's own), the others get 0.
 pub fn wall_density_rates<const D: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     grid: &Grid<D>,
     fluid: &Fluid<D>,
     bound: &mut Boundary<D>,
+    columns: Option<(i64, i64)>,
 ) {
     let Boundary {
         x: bx,
@@ -367,6 +372,13 @@ pub fn wall_density_rates<const D: usize, K: Kernel>(
             let mut fr: Ranges = NO_RANGES;
             for (o, out) in chunk.iter_mut().enumerate() {
                 let b = ci * CHUNK + o;
+                if let Some((lo, hi)) = columns {
+                    let col = grid.column(bx[0][b] as f64);
+                    if col < lo || col >= hi {
+                        *out = 0.0;
+                        continue;
+                    }
+                }
                 let xb: [f32; D] = std::array::from_fn(|d| bx[d][b]);
                 let n = grid.ranges(bcell[b], &fluid.starts, &mut fr);
                 let mut s = 0.0f32;
