@@ -149,11 +149,6 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         };
         let dom = match comm.filter(|c| c.size() > 1) {
             None => None,
-            Some(_) if params.solver.scheme == Scheme::Dfsph => {
-                return Err(SimError::Decomposition(
-                    "solver.scheme dfsph does not run across MPI ranks yet: run it in one process, or set solver.scheme wcsph for mpirun".into(),
-                ))
-            }
             Some(c) => Some(Domain::split(c, &grid, &mut fluid).map_err(SimError::Decomposition)?),
         };
         fluid.sort(&grid, &mut scratch);
@@ -231,11 +226,12 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     /// One step of the divergence-free scheme (see [`dfsph`]).
     fn step_dfsph(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
         let t = self.time;
-        let room = motion.end_time() - t;
+        let end = self.end_time(motion);
+        let room = end - t;
         if room <= 0.0 {
             return Err(SimError::MotionEnded {
                 time: t + self.stats.last_dt.max(self.dt_min),
-                end: motion.end_time(),
+                end,
             });
         }
         let r = self.solve_dfsph(motion, room, false)?;
@@ -284,10 +280,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     ) -> Result<dfsph::StepReport, SimError> {
         let t = self.time;
         let frame = self.frame(motion, t);
-        self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
-        if self.fluid.is_empty() {
-            return Err(SimError::AllParticlesLost { time: t });
-        }
+        self.rebin(t, false)?;
         self.fluid.refresh(|_, p| p as f32);
         let r = dfsph::step(
             &self.kernel,
@@ -301,6 +294,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             &mut self.dwork,
             room,
             prime,
+            self.dom
+                .as_mut()
+                .map(|d| d as &mut dyn crate::scheme::Ranks<D>),
         );
         if r.totals.non_finite {
             return Err(SimError::NonFinite {
@@ -360,33 +356,15 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     fn evaluate(&mut self, motion: &dyn TankMotion, t: f64, sort: bool) -> Result<(), SimError> {
         let frame = self.frame(motion, t);
         let walls = self.params.solver.boundary.method == BoundaryMethod::Dynamic;
-        if let Some(dom) = &mut self.dom {
-            // Across ranks: where a serial run sorts (the start of a step), particles move to their slab's
-            // rank, the halos are rebuilt and the slabs rebalanced now and then; in the middle of a step
-            // the halo copies are only brought up to date.
-            let walls = walls.then_some(&mut self.bound);
-            if sort {
-                let rebalance = self
-                    .stats
-                    .steps
-                    .is_multiple_of(REBALANCE_EVERY)
-                    .then_some(REBALANCE_TOLERANCE);
-                let lost = dom.exchange(&self.grid, &mut self.fluid, walls, rebalance);
-                self.fluid.sort(&self.grid, &mut self.scratch);
-                dom.index_halos(&self.grid, &self.fluid);
-                self.lost += lost;
-                dom.count(&self.fluid, self.lost);
-                if dom.fluid_total == 0 {
-                    return Err(SimError::AllParticlesLost { time: t });
-                }
-            } else {
-                dom.refresh(&self.grid, &mut self.fluid, walls);
-            }
-        } else if sort {
-            self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
-            if self.fluid.is_empty() {
-                return Err(SimError::AllParticlesLost { time: t });
-            }
+        if sort {
+            self.rebin(t, walls)?;
+        } else if let Some(dom) = &mut self.dom {
+            // Across ranks, in the middle of a step: the halo copies are brought up to date in place.
+            dom.refresh(
+                &self.grid,
+                &mut self.fluid,
+                walls.then_some(&mut self.bound),
+            );
         }
         let eos = self.eos;
         self.fluid.refresh(|r, _| eos.pressure(r));
@@ -415,20 +393,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             &mut self.work,
         );
         if let Some(dom) = &self.dom {
-            let l = &mut self.last;
-            let mut v = [
-                l.force[0],
-                l.force[1],
-                l.force[2],
-                l.moment[0],
-                l.moment[1],
-                l.moment[2],
-                f64::from(u8::from(l.non_finite)),
-            ];
-            dom.comm.reduce(&mut v, Op::Sum);
-            l.force = [v[0], v[1], v[2]];
-            l.moment = [v[3], v[4], v[5]];
-            l.non_finite = v[6] > 0.0;
+            self.last.reduce_with(|v| dom.comm.reduce(v, Op::Sum));
         }
         if walls {
             wcsph::wall_density_rates(
@@ -446,6 +411,45 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 time: t,
                 step: self.stats.steps,
             });
+        }
+        Ok(())
+    }
+
+    /// Across ranks, where one process sorts its cells: particles move to their slab's rank, the halos
+    /// (and with `walls`, the halo walls' densities) are rebuilt, the slabs rebalanced now and then.
+    fn redistribute(&mut self, t: f64, walls: bool) -> Result<(), SimError> {
+        let Some(dom) = &mut self.dom else {
+            return Ok(());
+        };
+        let rebalance = self
+            .stats
+            .steps
+            .is_multiple_of(REBALANCE_EVERY)
+            .then_some(REBALANCE_TOLERANCE);
+        let lost = dom.exchange(
+            &self.grid,
+            &mut self.fluid,
+            walls.then_some(&mut self.bound),
+            rebalance,
+        );
+        self.fluid.sort(&self.grid, &mut self.scratch);
+        dom.index_halos(&self.grid, &self.fluid);
+        self.lost += lost;
+        dom.count(&self.fluid, self.lost);
+        if dom.fluid_total == 0 {
+            return Err(SimError::AllParticlesLost { time: t });
+        }
+        Ok(())
+    }
+
+    /// Re-bins the liquid (across ranks: redistributes it) at time t.
+    fn rebin(&mut self, t: f64, walls: bool) -> Result<(), SimError> {
+        if self.dom.is_some() {
+            return self.redistribute(t, walls);
+        }
+        self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
+        if self.fluid.is_empty() {
+            return Err(SimError::AllParticlesLost { time: t });
         }
         Ok(())
     }
@@ -572,7 +576,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             if !self.rates_current {
                 self.solve_dfsph(motion, self.params.solver.dfsph.dt_max, true)?;
             }
-            self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
+            self.rebin(self.time, false)?;
             self.fluid.refresh(|_, p| p as f32);
         } else if !self.rates_current {
             self.evaluate(motion, self.time, true)?;

@@ -324,6 +324,29 @@ impl Domain {
         }
     }
 
+    /// Brings a per-particle quantity of the halo copies up to date from their owners: `get` appends a
+    /// particle's `width` values, `set` takes them. Collective.
+    pub fn sync_halo<T>(
+        &mut self,
+        field: &mut [T],
+        width: usize,
+        get: fn(&T, &mut Vec<f64>),
+        set: fn(&mut T, &[f64]),
+    ) {
+        for (s, out) in self.send.iter_mut().zip(&self.halo_out) {
+            s.clear();
+            for &i in out {
+                get(&field[i as usize], s);
+            }
+        }
+        self.comm.all_to_all(&self.send, &mut self.recv);
+        for (msg, into) in self.recv.iter().zip(&self.halo_in) {
+            for (r, &i) in msg.chunks_exact(width).zip(into) {
+                set(&mut field[i as usize], r);
+            }
+        }
+    }
+
     /// Appends to each neighbour's message the densities of this rank's wall particles in its halo (wall
     /// particles are the same, in the same order, on every rank).
     fn pack_walls<const D: usize>(&mut self, grid: &Grid<D>, walls: Option<&Boundary<D>>) {
@@ -363,5 +386,25 @@ impl Domain {
         } else {
             Vec::new()
         }
+    }
+}
+
+impl<const D: usize> crate::scheme::Ranks<D> for Domain {
+    fn total(&self) -> usize {
+        self.fluid_total
+    }
+    fn sync_scalar(&mut self, k: &mut [f32]) {
+        self.sync_halo(k, 1, |k, s| s.push(*k as f64), |k, r| *k = r[0] as f32);
+    }
+    fn sync_vector(&mut self, v: &mut [[f32; D]]) {
+        self.sync_halo(
+            v,
+            D,
+            |v, s| s.extend(v.iter().map(|&x| x as f64)),
+            |v, r| *v = std::array::from_fn(|d| r[d] as f32),
+        );
+    }
+    fn reduce(&mut self, v: &mut [f64], op: Op) {
+        self.comm.reduce(v, op);
     }
 }

@@ -1,11 +1,14 @@
 //! Domain decomposition across processes (the paper's MPI parallelisation, §2).
 //!
 //! The tank is cut across its length into slabs of whole neighbour-grid columns, one per rank ([`Slabs`]).
-//! A rank integrates the liquid particles in its slab; before every force evaluation it exchanges, in one
-//! all-to-all, the particles that crossed into another slab (with their whole state) and copies of its
-//! particles within two columns (one kernel support) of a neighbour's slab, the neighbour's halo; the
-//! wall particles are the same on every rank and the neighbours' halo walls get their densities from their
-//! owner. Halo copies are marked in their id ([`crate::particles::HALO`]) and left out of every total.
+//! A rank integrates the liquid particles in its slab. Where a serial run sorts its cells (the start of a
+//! step) it exchanges, in one all-to-all, the particles that crossed into another slab (with their whole
+//! state) and copies of its particles within two columns (one kernel support) of a neighbour's slab, the
+//! neighbour's halo; between sorts (the weakly-compressible half step, the incompressible pressure
+//! iterations) only the halo copies' values are refreshed in place ([`Domain::refresh`],
+//! [`crate::scheme::Ranks`]). The wall particles are the same on every rank; the neighbours' halo walls get
+//! their densities from their owner. Halo copies are marked in their id ([`crate::particles::HALO`]) and
+//! left out of every pass and total.
 //!
 //! Because slabs are whole columns and the halo is two columns, a particle sees the same candidate
 //! neighbours, in the same order (cells are ordered by particle id), as in one process: the rates, the

@@ -25,11 +25,12 @@
 //! results do not depend on the number of threads.
 
 use super::candidates::{lane_sum, wide_lanes, Candidates, LANES};
-use super::{FrameTerms, PassTotals, CHUNK};
+use super::{FrameTerms, PassTotals, Ranks, CHUNK};
+use crate::domain::Op;
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DfsphSpec;
-use crate::particles::{Boundary, Fluid};
+use crate::particles::{Boundary, Fluid, HALO};
 use crate::tank::{cross, from3, to3};
 use rayon::prelude::*;
 
@@ -43,6 +44,10 @@ pub const MIRROR: f32 = 1.0;
 /// two-sided update from the full pressure with Chebyshev acceleration needs 2–3× fewer iterations, but its
 /// pressure field is noisy enough to shift the first sloshing mode's period by 5 %.)
 const WARM: f32 = 0.5;
+
+/// Density errors are summed in units of 2^-20 kg/m³, as integers: the sum (and so the iteration count)
+/// does not depend on the order of the additions, which differs between one process and several ranks.
+const ERR_SCALE: f64 = (1u64 << 20) as f64;
 
 /// Constants of the scheme in the precision of the loops.
 #[derive(Clone, Copy, Debug)]
@@ -78,7 +83,8 @@ struct Lists<const D: usize> {
 struct Partial {
     totals: PassTotals,
     max_speed: f32,
-    error: f64,
+    /// Summed error in units of 1 / [`ERR_SCALE`].
+    error: u64,
 }
 
 impl Partial {
@@ -318,6 +324,18 @@ fn build_chunk<const D: usize, K: Kernel>(
     let mut filled = u32::MAX;
     for o in 0..rho.len() {
         let a = first + o;
+        if f.id[a] & HALO != 0 {
+            // A halo copy (across ranks): its owner solves for it; it takes no part here but as a
+            // neighbour, with no error and no k of its own until its owner's arrive.
+            lists.start.push(lists.j.len() as u32);
+            rho[o] = c.rho_rest;
+            factor[o] = 0.0;
+            acc[o] = [0.0; D];
+            lists.gb.push([0.0; D]);
+            lists.mb.push([0.0; 3]);
+            lists.full.push(false);
+            continue;
+        }
         if f.cell[a] != filled {
             // Particles are sorted by cell: the candidates change only when the cell does.
             filled = f.cell[a];
@@ -406,7 +424,7 @@ fn error_chunk<const D: usize>(
     (rho, factor): (&[f32], &[f32]),
     k: &mut [f32],
 ) -> Partial {
-    let mut err = 0.0f64;
+    let mut err = 0u64;
     for o in 0..k.len() {
         let a = first + o;
         let va = vel[a];
@@ -436,7 +454,7 @@ fn error_chunk<const D: usize>(
             }
         };
         k[o] = kk;
-        err += e as f64;
+        err += (e as f64 * ERR_SCALE).round() as u64;
     }
     Partial {
         error: err,
@@ -525,7 +543,7 @@ impl<const D: usize> Workspace<D> {
         merged(partials)
     }
 
-    /// Pass 2: errors and k; returns the mean error as a fraction of ρ_rest.
+    /// Pass 2: errors and k; returns the summed error in units of 1 / [`ERR_SCALE`].
     fn errors(&mut self, c: &Coefficients, mode: Mode, dt: f32) -> f64 {
         let Workspace {
             lists,
@@ -536,7 +554,6 @@ impl<const D: usize> Workspace<D> {
             partials,
             ..
         } = self;
-        let n = rho.len();
         let vel = &*vel;
         k.par_chunks_mut(CHUNK)
             .zip(lists.par_iter())
@@ -555,7 +572,7 @@ impl<const D: usize> Workspace<D> {
                 )
             })
             .collect_into_vec(partials);
-        merged(partials).error / (n.max(1) as f64 * c.rho_rest as f64)
+        merged(partials).error as f64
     }
 
     /// Pass 3: velocity update.
@@ -592,8 +609,11 @@ impl<const D: usize> Workspace<D> {
 
     /// Starts from half the pressure `warm` of the last step (p/ρ², applied as a first velocity update), then
     /// iterates passes 2 and 3 until the mean error is below `tol` (at least `min` iterations, at most
-    /// `max`). Returns (iterations, final error, wall totals); `ksum` holds the solve's total k.
-    fn solve(
+    /// `max`). Returns (iterations, final error, wall totals); `ksum` holds the solve's total k. Across
+    /// `ranks`, the halo copies take their owners' k and velocities after every pass and the error is the
+    /// mean over all ranks.
+    #[allow(clippy::too_many_arguments)]
+    fn solve<'r>(
         &mut self,
         c: &Coefficients,
         mode: Mode,
@@ -601,19 +621,32 @@ impl<const D: usize> Workspace<D> {
         tol: f64,
         (min, max): (u32, u32),
         warm: &[f64],
+        mut ranks: Option<&mut (dyn Ranks<D> + 'r)>,
     ) -> (u32, f64, PassTotals) {
         self.ksum.iter_mut().for_each(|k| *k = 0.0);
         for (k, w) in self.k.iter_mut().zip(warm) {
             *k = WARM * *w as f32;
         }
         self.update(c, dt);
+        if let Some(r) = ranks.as_deref_mut() {
+            r.sync_vector(&mut self.vel);
+        }
+        let total = ranks.as_ref().map_or(self.rho.len(), |r| r.total());
         let mut it = 0;
         loop {
-            let err = self.errors(c, mode, dt);
+            let mut sum = [self.errors(c, mode, dt)];
+            if let Some(r) = ranks.as_deref_mut() {
+                r.sync_scalar(&mut self.k);
+                r.reduce(&mut sum, Op::Sum);
+            }
+            let err = sum[0] / ERR_SCALE / (total.max(1) as f64 * c.rho_rest as f64);
             if (it >= min && err <= tol) || it >= max {
                 return (it, err, self.wall_totals(c));
             }
             self.update(c, dt);
+            if let Some(r) = ranks.as_deref_mut() {
+                r.sync_vector(&mut self.vel);
+            }
             it += 1;
         }
     }
@@ -631,7 +664,7 @@ fn merged(partials: &[Partial]) -> Partial {
 /// `fluid.pos`/`fluid.vel` (f64) by dt, or, when `prime` is set, only computes the pressures and wall force
 /// of the current state and leaves it where it is. Fills `fluid.r` (summed density) and `fluid.p`.
 #[allow(clippy::too_many_arguments)]
-pub fn step<const D: usize, K: Kernel>(
+pub fn step<'r, const D: usize, K: Kernel>(
     kernel: &K,
     c: &Coefficients,
     spec: &DfsphSpec,
@@ -643,6 +676,7 @@ pub fn step<const D: usize, K: Kernel>(
     work: &mut Workspace<D>,
     dt_limit: f64,
     prime: bool,
+    mut ranks: Option<&mut (dyn Ranks<D> + 'r)>,
 ) -> StepReport {
     let n = fluid.len();
     work.resize(n);
@@ -660,9 +694,12 @@ pub fn step<const D: usize, K: Kernel>(
         totals: built.totals,
         ..Default::default()
     };
-    // dt from the flow speed and the accelerations.
-    let vmax = built.max_speed as f64;
-    let amax = built.totals.max_acc as f64;
+    // dt from the flow speed and the accelerations (over all ranks).
+    let mut max = [built.max_speed as f64, built.totals.max_acc as f64];
+    if let Some(r) = ranks.as_deref_mut() {
+        r.reduce(&mut max, Op::Max);
+    }
+    let [vmax, amax] = max;
     let mut dt = spec.dt_max;
     if vmax > 0.0 {
         dt = dt.min(spec.cfl * dp / vmax);
@@ -698,6 +735,7 @@ pub fn step<const D: usize, K: Kernel>(
                 spec.max_divergence_error,
                 (1, spec.max_iterations),
                 &fluid.kappa_div,
+                ranks.as_deref_mut(),
             );
             report.divergence_iterations += it;
             report.totals.force = add(report.totals.force, t.force);
@@ -709,6 +747,9 @@ pub fn step<const D: usize, K: Kernel>(
                 v[d] += dtf * a[d];
             }
         }
+        if let Some(r) = ranks.as_deref_mut() {
+            r.sync_vector(&mut work.vel);
+        }
         let (it, err, t) = work.solve(
             c,
             Mode::Density,
@@ -716,6 +757,7 @@ pub fn step<const D: usize, K: Kernel>(
             spec.max_density_error,
             (spec.min_iterations, spec.max_iterations),
             &fluid.kappa,
+            ranks.as_deref_mut(),
         );
         report.density_iterations += it;
         report.density_error = err;
@@ -747,6 +789,9 @@ pub fn step<const D: usize, K: Kernel>(
     report.dt = dt;
     if work.vel.iter().any(|v| !v.iter().all(|x| x.is_finite())) {
         report.totals.non_finite = true;
+    }
+    if let Some(r) = ranks {
+        report.totals.reduce_with(|v| r.reduce(v, Op::Sum));
     }
     // Pressures of the state (p = ρ² Σk) and its summed densities, for the observables.
     for (a, ((k, kd), r)) in work.ksum.iter().zip(&work.kdiv).zip(&work.rho).enumerate() {

@@ -9,6 +9,17 @@ pub mod wcsph;
 /// number of threads).
 pub const CHUNK: usize = 256;
 
+/// What a scheme needs across ranks (MPI domain decomposition, [`crate::domain`]); `None` in one process.
+pub trait Ranks<const D: usize> {
+    /// Liquid particles on all ranks.
+    fn total(&self) -> usize;
+    /// The halo copies' values of a per-particle scalar, and of a per-particle vector, from their owners.
+    fn sync_scalar(&mut self, k: &mut [f32]);
+    fn sync_vector(&mut self, v: &mut [[f32; D]]);
+    /// Element-wise sum or extreme over ranks.
+    fn reduce(&mut self, v: &mut [f64], op: crate::domain::Op);
+}
+
 /// The tank frame's motion as the particles feel it, in the tank frame (x, y, z).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameTerms {
@@ -56,6 +67,18 @@ pub struct PassTotals {
 }
 
 impl PassTotals {
+    /// Sums force, moment and the non-finite flag with `reduce` (over ranks).
+    pub fn reduce_with(&mut self, reduce: impl FnOnce(&mut [f64])) {
+        let mut v = [0.0; 7];
+        v[..3].copy_from_slice(&self.force);
+        v[3..6].copy_from_slice(&self.moment);
+        v[6] = f64::from(u8::from(self.non_finite));
+        reduce(&mut v);
+        self.force.copy_from_slice(&v[..3]);
+        self.moment.copy_from_slice(&v[3..6]);
+        self.non_finite = v[6] > 0.0;
+    }
+
     pub fn merge(&mut self, o: &PassTotals) {
         for k in 0..3 {
             self.force[k] += o.force[k];
