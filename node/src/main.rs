@@ -280,7 +280,15 @@ fn main() -> anyhow::Result<()> {
     // Under mpirun every rank runs this binary: rank 0 goes on with the command (its simulations spread
     // over all ranks), the others follow its solver calls until it is done.
     #[cfg(feature = "mpi")]
-    let _lead = match sph::domain::mpi::start().map_err(anyhow::Error::msg)? {
+    let _lead = match sph::domain::mpi::start(|| {
+        // mpirun passes SIGINT/SIGTERM to every rank; rank 0 finishes its outputs, then releases the others.
+        let ignored = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+            let _ = signal_hook::flag::register(sig, ignored.clone());
+        }
+    })
+    .map_err(anyhow::Error::msg)?
+    {
         sph::domain::mpi::Role::Follow => return Ok(()),
         sph::domain::mpi::Role::Lead(l) => {
             if l.ranks() > 1 {

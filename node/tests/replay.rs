@@ -390,3 +390,56 @@ fn replay_on_two_mpi_ranks_equals_the_serial_replay() {
         assert_eq!(items.len(), w.len(), "{reader}");
     }
 }
+
+/// Ctrl-C on `mpirun` (which sends SIGINT/SIGTERM to every rank, then kills them): rank 0 stops, finishes
+/// the CSVs, summary.json and the recording, and releases the other ranks, which wait for it.
+#[cfg(feature = "mpi")]
+#[test]
+fn interrupting_mpirun_leaves_finished_outputs_and_a_readable_recording() {
+    let (dir, case) = setup("replay-mpi-int", 30.0);
+    let bag = write_bag(&dir, "odom_bag", &["--type", "odom"]);
+    let out = dir.join("ranks2");
+    let mut child = common::mpirun(2)
+        .arg("replay")
+        .arg(&bag)
+        .arg("--config")
+        .arg(&case)
+        .arg("--out")
+        .arg(&out)
+        .args(["--rate", "1"])
+        .spawn()
+        .unwrap();
+    // Until the run is well under way.
+    let start = std::time::Instant::now();
+    while csv_rows(&out.join("probes.csv")) < 20 {
+        assert!(start.elapsed().as_secs() < 60, "the replay did not start");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let st = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let _ = child.wait().unwrap();
+    let s = summary(&out);
+    assert!(
+        s["error"]
+            .as_str()
+            .unwrap_or_default()
+            .contains("interrupted"),
+        "{s}"
+    );
+    assert_eq!(s["mpi_ranks"], 2);
+    let rows = csv(&out.join("probes.csv")).1.len();
+    let v = common::read_bag(&out.join("bag"));
+    for reader in ["rosbags", "mcap"] {
+        let items = v[reader]["/probes"]["items"].as_array().unwrap();
+        assert_eq!(items.len(), rows, "{reader}");
+    }
+}
+
+/// Rows written so far to a CSV (0 before it exists).
+#[cfg(feature = "mpi")]
+fn csv_rows(path: &Path) -> usize {
+    std::fs::read_to_string(path).map_or(0, |t| t.lines().count().saturating_sub(1))
+}

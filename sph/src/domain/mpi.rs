@@ -105,8 +105,10 @@ impl Drop for Lead {
 }
 
 /// Starts MPI. Errors if MPI was started already or does not allow calls from a thread other than the
-/// main one at a time (`MPI_THREAD_SERIALIZED`).
-pub fn start() -> Result<Role, String> {
+/// main one at a time (`MPI_THREAD_SERIALIZED`). `following` runs on the ranks other than 0 before they
+/// start serving (e.g. to ignore the SIGINT/SIGTERM that `mpirun` sends every rank: rank 0 stops them once
+/// it has finished its files).
+pub fn start(following: impl FnOnce()) -> Result<Role, String> {
     let (universe, threading) = mpi::initialize_with_threading(Threading::Serialized)
         .ok_or("MPI was already initialised")?;
     if threading < Threading::Serialized {
@@ -120,6 +122,7 @@ pub fn start() -> Result<Role, String> {
     if ranks > 1 {
         super::install(Arc::new(super::Timed::new(MpiComm { world })));
         if rank != 0 {
+            following();
             super::serve();
             drop(universe);
             return Ok(Role::Follow);
