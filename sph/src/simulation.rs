@@ -615,19 +615,20 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             .pressure_sensors
             .iter()
             .map(|s| {
-                if !mine(s.x) {
-                    return 0.0;
-                }
                 let at: [f64; D] = from3([s.x, s.y, s.z]);
                 match wall_pressure::face_of(&self.tank, at, 0.5 * dp) {
                     Some(face) if dfsph => {
+                        // A sum over the wall particles behind the sensor, which may reach further than a
+                        // halo: across ranks, each adds its own walls' part.
                         let f = &self.fluid;
+                        let b = &self.bound;
                         wall_pressure::wall_pressure(
                             k,
                             &self.grid,
                             f,
-                            &self.bound,
+                            b,
                             |i| f.kappa[i] + f.kappa_div[i],
+                            |j| mine(b.x[0][j] as f64),
                             (
                                 self.coef.m_fluid as f64,
                                 self.coef.m_bound as f64,
@@ -637,6 +638,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                             face,
                         )
                     }
+                    _ if !mine(s.x) => 0.0,
                     _ => pressure::pressure(k, &self.grid, &self.fluid, m, at),
                 }
             })
@@ -761,6 +763,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     }
 
     /// Every particle's position, velocity, pressure and density now, in the tank frame (changes nothing).
+    /// Across ranks: on rank 0, the liquid of all ranks in the order of the ids (one process: in cell order)
+    /// and the wall layers with their owners' densities (mirror ghosts: rank 0's own); empty elsewhere.
     pub fn snapshot(&self) -> Snapshot {
         let (f, b) = (&self.fluid, &self.bound);
         let (nf, nb) = (f.len(), b.len());
@@ -813,7 +817,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     /// Rank 0: the liquid of every rank (in the order of the ids) and the walls with their owners'
     /// densities. Other ranks send theirs and get an empty snapshot.
     fn gather_snapshot(&self, dom: &Domain, mut s: Snapshot) -> Snapshot {
-        let (b, dfsph) = (&self.bound, false);
+        let b = &self.bound;
+        let dfsph = self.params.solver.scheme == Scheme::Dfsph;
+        // Wall layers carry their owner's density; mirror ghosts differ from rank to rank: rank 0's are
+        // written.
+        let walls = self.params.solver.boundary.method == BoundaryMethod::Dynamic;
         let mut local = Vec::with_capacity(s.fluid * 9 + 1);
         local.push(s.fluid as f64);
         for i in 0..s.fluid {
@@ -826,7 +834,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             );
             local.extend([s.pressure[i] as f64, s.density[i] as f64]);
         }
-        for j in 0..b.rho.len() {
+        for j in (0..b.rho.len()).filter(|_| walls) {
             if dom.owns(&self.grid, b.x[0][j] as f64) {
                 local.extend([j as f64, b.rho[j]]);
             }
@@ -864,7 +872,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             let rho = wall_rho.get(j).map_or(self.eos.rho0, |&r| r as f32);
             s.pressure
                 .push(if dfsph { 0.0 } else { self.eos.pressure(rho) });
-            s.density.push(rho);
+            s.density
+                .push(if dfsph { self.dcoef.rho_rest } else { rho });
             s.id.push(j as u32);
         }
         s

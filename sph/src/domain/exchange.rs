@@ -201,19 +201,19 @@ impl Domain {
             let before = self.slabs.clone();
             self.rebalance(grid, fluid, tolerance);
             if let Some(w) = walls.as_deref_mut().filter(|_| self.slabs != before) {
-                // Wall densities are kept up to date by their owners only: every rank learns them all.
-                let mut rho: Vec<f64> = (0..w.len())
-                    .map(|j| {
-                        let mine = before.owner(grid.column(w.x[0][j] as f64)) == me;
-                        if mine {
-                            w.rho[j]
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect();
+                // Wall densities (now and the previous step's, for Verlet) are kept up to date by their
+                // owners only: every rank learns them all.
+                let n = w.len();
+                let mut rho = vec![0.0; 2 * n];
+                for j in 0..n {
+                    if before.owner(grid.column(w.x[0][j] as f64)) == me {
+                        rho[j] = w.rho[j];
+                        rho[n + j] = w.rho0[j];
+                    }
+                }
                 self.comm.reduce(&mut rho, Op::Sum);
-                w.rho.copy_from_slice(&rho);
+                w.rho.copy_from_slice(&rho[..n]);
+                w.rho0.copy_from_slice(&rho[n..]);
             }
         }
 

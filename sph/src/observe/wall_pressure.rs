@@ -44,7 +44,8 @@ fn lateral_w(dim: usize, h: f64, r: f64) -> f64 {
 }
 
 /// Pressure on the face (`axis`, outward `sign`) at `p`, from the liquid's wall forces: particle i pushes wall
-/// particle b with `mirror · m_i m_b k_i ∇_i W_ib`, k_i (p/ρ²) from `kappa`.
+/// particle b with `mirror · m_i m_b k_i ∇_i W_ib`, k_i (p/ρ²) from `kappa`. Only the wall particles b with
+/// `walls(b)` count (across ranks, each rank's own: the parts add up).
 #[allow(clippy::too_many_arguments)]
 pub fn wall_pressure<const D: usize, K: Kernel>(
     k: &K,
@@ -52,6 +53,7 @@ pub fn wall_pressure<const D: usize, K: Kernel>(
     fluid: &Fluid<D>,
     bound: &Boundary<D>,
     kappa: impl Fn(usize) -> f64,
+    walls: impl Fn(usize) -> bool,
     (m_fluid, m_bound, mirror): (f64, f64, f64),
     p: [f64; D],
     (axis, sign): (usize, f64),
@@ -62,6 +64,9 @@ pub fn wall_pressure<const D: usize, K: Kernel>(
     let mut ranges = NO_RANGES;
     let mut total = 0.0;
     for b in 0..bound.len() {
+        if !walls(b) {
+            continue;
+        }
         let xb: [f64; D] = std::array::from_fn(|d| bound.x[d][b] as f64);
         // Behind the face, within a support of the sensor along it.
         if (xb[axis] - p[axis]) * sign <= 0.0 {

@@ -91,7 +91,7 @@ impl Partial {
     fn merge(&mut self, o: &Partial) {
         self.totals.merge(&o.totals);
         self.max_speed = self.max_speed.max(o.max_speed);
-        self.error += o.error;
+        self.error = self.error.saturating_add(o.error);
     }
 }
 
@@ -455,7 +455,8 @@ fn error_chunk<const D: usize>(
         };
         k[o] = kk;
         // e ≥ 0: adding ½ and truncating rounds, and through i64 it is one instruction (no libm call).
-        err += (e as f64 * ERR_SCALE + 0.5) as i64 as u64;
+        // (A non-finite error saturates instead of wrapping round to a small sum.)
+        err = err.saturating_add((e as f64 * ERR_SCALE + 0.5) as i64 as u64);
     }
     Partial {
         error: err,
