@@ -149,7 +149,15 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         };
         let dom = match comm.filter(|c| c.size() > 1) {
             None => None,
-            Some(c) => Some(Domain::split(c, &grid, &mut fluid).map_err(SimError::Decomposition)?),
+            Some(c) => {
+                // Mirror ghosts are rebuilt from where particles are mid-step, which may be a column
+                // beyond where they were sorted: one more halo column brings their sources.
+                let halo = match params.solver.boundary.method {
+                    BoundaryMethod::Mirror => crate::neighbours::REACH + 1,
+                    BoundaryMethod::Dynamic => crate::neighbours::REACH,
+                };
+                Some(Domain::split(c, &grid, &mut fluid, halo).map_err(SimError::Decomposition)?)
+            }
         };
         fluid.sort(&grid, &mut scratch);
 

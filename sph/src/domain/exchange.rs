@@ -99,10 +99,12 @@ fn compact<const D: usize>(f: &mut Fluid<D>, keep: &[Option<u32>]) {
 impl Domain {
     /// The slabs that share `fluid` (the whole initial liquid, the same on every rank) evenly; keeps this
     /// rank's part of it.
+    /// `halo`: columns of the halos (a kernel support is [`crate::neighbours::REACH`]).
     pub fn split<const D: usize>(
         comm: Arc<dyn Comm>,
         grid: &Grid<D>,
         fluid: &mut Fluid<D>,
+        halo: i64,
     ) -> Result<Self, String> {
         let columns = grid.dims()[0];
         let mut hist = vec![0.0; columns];
@@ -110,7 +112,7 @@ impl Domain {
             let c = grid.column(x).clamp(0, columns as i64 - 1);
             hist[c as usize] += 1.0;
         }
-        let slabs = Slabs::balanced(&hist, comm.size())?;
+        let slabs = Slabs::balanced(&hist, comm.size(), halo)?;
         let me = comm.rank();
         let keep: Vec<Option<u32>> = (0..fluid.len())
             .map(|i| (slabs.owner(grid.column(fluid.pos[0][i])) == me).then_some(fluid.id[i]))
@@ -159,7 +161,7 @@ impl Domain {
         }
         self.comm.reduce(&mut self.hist, Op::Sum);
         // The same sums on every rank give the same cuts; they fit, as the first ones did.
-        if let Ok(s) = Slabs::balanced(&self.hist, n) {
+        if let Ok(s) = Slabs::balanced(&self.hist, n, self.slabs.halo()) {
             if s != self.slabs {
                 self.slabs = s;
                 self.rebalances += 1;

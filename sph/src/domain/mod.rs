@@ -25,6 +25,7 @@ mod exchange;
 pub mod mpi;
 mod service;
 mod slabs;
+pub mod threads;
 
 pub use exchange::Domain;
 pub use service::{comm_seconds, install, ranks, serve, shutdown, world, Distributed};

@@ -3,9 +3,11 @@
 use crate::neighbours::REACH;
 
 /// Rank k owns the cell columns `cuts[k]..cuts[k + 1]`; the first and the last slab run on without end.
+/// A particle is copied into the halo of the ranks owning columns within `halo` of its own.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Slabs {
     cuts: Vec<i64>,
+    halo: i64,
 }
 
 impl Slabs {
@@ -13,17 +15,20 @@ impl Slabs {
     pub fn whole() -> Self {
         Self {
             cuts: vec![i64::MIN, i64::MAX],
+            halo: REACH,
         }
     }
 
-    /// Cuts that share `counts` (particles per grid column) evenly among `ranks`, every slab at least
-    /// [`REACH`] columns wide so that a particle's neighbours lie in its own or the adjacent slabs.
-    pub fn balanced(counts: &[f64], ranks: usize) -> Result<Self, String> {
+    /// Cuts that share `counts` (particles per grid column) evenly among `ranks`, with halos `halo`
+    /// columns wide (at least [`REACH`], a kernel support), every slab at least that wide so that a
+    /// particle's halo copies go to the adjacent slabs only.
+    pub fn balanced(counts: &[f64], ranks: usize, halo: i64) -> Result<Self, String> {
         let columns = counts.len() as i64;
-        if ranks as i64 * REACH > columns {
+        let w = halo.max(REACH);
+        if ranks as i64 * w > columns {
             return Err(format!(
-                "{ranks} ranks do not fit across this tank: it is {columns} neighbour-grid columns long and each rank needs at least {REACH}; run on at most {} ranks",
-                (columns / REACH).max(1)
+                "{ranks} ranks do not fit across this tank: it is {columns} neighbour-grid columns long and each rank needs at least {w}; run on at most {} ranks",
+                (columns / w).max(1)
             ));
         }
         let total: f64 = counts.iter().sum();
@@ -41,18 +46,18 @@ impl Slabs {
         }
         // Every slab at least REACH columns, within the grid (the later ones pushed along, then back).
         for k in 1..ranks {
-            let lo = if k == 1 { REACH } else { cuts[k - 1] + REACH };
+            let lo = if k == 1 { w } else { cuts[k - 1] + w };
             cuts[k] = cuts[k].max(lo);
         }
         for k in (1..ranks).rev() {
             let hi = if k == ranks - 1 {
-                columns - REACH
+                columns - w
             } else {
-                cuts[k + 1] - REACH
+                cuts[k + 1] - w
             };
             cuts[k] = cuts[k].min(hi);
         }
-        Ok(Self { cuts })
+        Ok(Self { cuts, halo: w })
     }
 
     pub fn ranks(&self) -> usize {
@@ -71,14 +76,19 @@ impl Slabs {
     }
 
     /// The ranks besides `owner` (the owner of `col`) that need a copy of a particle in column `col`: the
-    /// adjacent slabs whose particles are within [`REACH`] columns.
+    /// adjacent slabs within the halo width.
     #[inline]
     pub fn halo_of(&self, owner: usize, col: i64) -> [Option<usize>; 2] {
         let (lo, hi) = self.columns(owner);
         [
-            (owner > 0 && col < lo + REACH).then(|| owner - 1),
-            (owner + 1 < self.ranks() && col >= hi - REACH).then_some(owner + 1),
+            (owner > 0 && col < lo + self.halo).then(|| owner - 1),
+            (owner + 1 < self.ranks() && col >= hi - self.halo).then_some(owner + 1),
         ]
+    }
+
+    /// Columns of the halo.
+    pub fn halo(&self) -> i64 {
+        self.halo
     }
 }
 
@@ -90,7 +100,7 @@ mod tests {
     fn balanced_cuts_share_the_particles_and_keep_slabs_wide_enough() {
         // 40 columns, particles piled up at the right end.
         let counts: Vec<f64> = (0..40).map(|c| if c < 30 { 1.0 } else { 20.0 }).collect();
-        let s = Slabs::balanced(&counts, 4).unwrap();
+        let s = Slabs::balanced(&counts, 4, REACH).unwrap();
         assert_eq!(s.ranks(), 4);
         let share = |r: usize| -> f64 {
             (0..40i64)
@@ -127,10 +137,16 @@ mod tests {
             }
         }
         // Even counts: equal slabs.
-        let flat = Slabs::balanced(&[1.0; 12], 3).unwrap();
+        let flat = Slabs::balanced(&[1.0; 12], 3, REACH).unwrap();
         assert_eq!((flat.columns(1).0, flat.columns(2).0), (4, 8));
         // Too many ranks for the tank is an error that names the limit.
-        let e = Slabs::balanced(&[1.0; 5], 3).unwrap_err();
+        let e = Slabs::balanced(&[1.0; 5], 3, REACH).unwrap_err();
         assert!(e.contains("at most 2 ranks"), "{e}");
+        // Wider halos (mirror ghosts): wider slabs, copies still to the adjacent ranks only.
+        let wide = Slabs::balanced(&[1.0; 12], 3, REACH + 1).unwrap();
+        assert_eq!(wide.halo_of(1, 4), [Some(0), None]);
+        assert_eq!(wide.halo_of(1, 7), [None, Some(2)]);
+        assert_eq!(wide.halo_of(1, 5), [Some(0), Some(2)]);
+        assert!(Slabs::balanced(&[1.0; 8], 3, REACH + 1).is_err());
     }
 }
