@@ -281,11 +281,9 @@ fn main() -> anyhow::Result<()> {
     // over all ranks), the others follow its solver calls until it is done.
     #[cfg(feature = "mpi")]
     let _lead = match sph::domain::mpi::start(|| {
-        // mpirun passes SIGINT/SIGTERM to every rank; rank 0 finishes its outputs, then releases the others.
-        let ignored = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-            let _ = signal_hook::flag::register(sig, ignored.clone());
-        }
+        // mpirun passes SIGINT/SIGTERM to every rank; rank 0 finishes its outputs, then releases the
+        // others: here the signals only set a flag nobody reads.
+        let _ = ros::shutdown_flag();
     })
     .map_err(anyhow::Error::msg)?
     {

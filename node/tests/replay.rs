@@ -60,13 +60,7 @@ fn write_bag(dir: &Path, bag: &str, args: &[&str]) -> PathBuf {
 
 /// `slosh replay BAG --config CASE --out OUT extra...`: (success, stderr).
 fn replay(bag: &Path, case: &Path, out: &Path, extra: &[&str]) -> (bool, String) {
-    let o = slosh()
-        .arg("replay")
-        .arg(bag)
-        .arg("--config")
-        .arg(case)
-        .arg("--out")
-        .arg(out)
+    let o = replay_by(slosh(), bag, case, out)
         .args(extra)
         .env("RUST_BACKTRACE", "0")
         .output()
@@ -75,6 +69,17 @@ fn replay(bag: &Path, case: &Path, out: &Path, extra: &[&str]) -> (bool, String)
         o.status.success(),
         String::from_utf8_lossy(&o.stderr).into(),
     )
+}
+
+/// `cmd replay BAG --config CASE --out OUT` (`cmd`: the binary, or mpirun starting it).
+fn replay_by(mut cmd: Command, bag: &Path, case: &Path, out: &Path) -> Command {
+    cmd.arg("replay")
+        .arg(bag)
+        .arg("--config")
+        .arg(case)
+        .arg("--out")
+        .arg(out);
+    cmd
 }
 
 fn summary(out: &Path) -> Value {
@@ -359,13 +364,7 @@ fn replay_on_two_mpi_ranks_equals_the_serial_replay() {
     let (ok, err) = replay(&bag, &case, &serial, &["--duration", "1.0"]);
     assert!(ok, "{err}");
     let out = dir.join("ranks2");
-    let o = common::mpirun(2)
-        .arg("replay")
-        .arg(&bag)
-        .arg("--config")
-        .arg(&case)
-        .arg("--out")
-        .arg(&out)
+    let o = replay_by(common::mpirun(2), &bag, &case, &out)
         .args(["--duration", "1.0"])
         .output()
         .unwrap();
@@ -399,13 +398,7 @@ fn interrupting_mpirun_leaves_finished_outputs_and_a_readable_recording() {
     let (dir, case) = setup("replay-mpi-int", 30.0);
     let bag = write_bag(&dir, "odom_bag", &["--type", "odom"]);
     let out = dir.join("ranks2");
-    let mut child = common::mpirun(2)
-        .arg("replay")
-        .arg(&bag)
-        .arg("--config")
-        .arg(&case)
-        .arg("--out")
-        .arg(&out)
+    let mut child = replay_by(common::mpirun(2), &bag, &case, &out)
         .args(["--rate", "1"])
         .spawn()
         .unwrap();

@@ -64,6 +64,15 @@ fn pull_record<const D: usize>(f: &mut Fluid<D>, r: &[f64]) {
     f.id.push(s[5] as u32);
 }
 
+/// Owned liquid particles per grid column (those off the grid counted in the end columns).
+fn column_counts<const D: usize>(grid: &Grid<D>, fluid: &Fluid<D>, hist: &mut [f64]) {
+    let last = hist.len() as i64 - 1;
+    hist.iter_mut().for_each(|h| *h = 0.0);
+    for i in (0..fluid.len()).filter(|&i| fluid.owned(i)) {
+        hist[grid.column(fluid.pos[0][i]).clamp(0, last) as usize] += 1.0;
+    }
+}
+
 fn unpack_walls<const D: usize>(w: &mut Boundary<D>, pairs: &[f64]) {
     for p in pairs.chunks_exact(2) {
         w.rho[p[0] as usize] = p[1];
@@ -106,12 +115,8 @@ impl Domain {
         fluid: &mut Fluid<D>,
         halo: i64,
     ) -> Result<Self, String> {
-        let columns = grid.dims()[0];
-        let mut hist = vec![0.0; columns];
-        for &x in &fluid.pos[0] {
-            let c = grid.column(x).clamp(0, columns as i64 - 1);
-            hist[c as usize] += 1.0;
-        }
+        let mut hist = vec![0.0; grid.dims()[0]];
+        column_counts(grid, fluid, &mut hist);
         let slabs = Slabs::balanced(&hist, comm.size(), halo)?;
         let me = comm.rank();
         let keep: Vec<Option<u32>> = (0..fluid.len())
@@ -153,12 +158,7 @@ impl Domain {
         if max <= (1.0 + tolerance) * mean {
             return;
         }
-        let columns = grid.dims()[0] as i64;
-        self.hist.iter_mut().for_each(|h| *h = 0.0);
-        for i in (0..fluid.len()).filter(|&i| fluid.owned(i)) {
-            let c = grid.column(fluid.pos[0][i]).clamp(0, columns - 1);
-            self.hist[c as usize] += 1.0;
-        }
+        column_counts(grid, fluid, &mut self.hist);
         self.comm.reduce(&mut self.hist, Op::Sum);
         // The same sums on every rank give the same cuts; they fit, as the first ones did.
         if let Ok(s) = Slabs::balanced(&self.hist, n, self.slabs.halo()) {
@@ -182,22 +182,20 @@ impl Domain {
         rebalance: Option<f64>,
     ) -> usize {
         let me = self.comm.rank();
-        // Halos go first: only owned particles travel or are copied.
-        let owned: Vec<Option<u32>> = fluid
-            .id
-            .iter()
-            .map(|&id| (id & HALO == 0).then_some(id))
-            .collect();
-        compact(fluid, &owned);
+        // Halos go first (only owned particles travel or are copied), and owned particles off the grid.
         let mut lost = 0;
-        let inside: Vec<Option<u32>> = (0..fluid.len())
+        let kept: Vec<Option<u32>> = (0..fluid.len())
             .map(|i| {
-                let ok = grid.cell_of(fluid.position(i)) != OUTSIDE;
-                lost += usize::from(!ok);
-                ok.then_some(fluid.id[i])
+                let id = fluid.id[i];
+                if id & HALO != 0 {
+                    return None;
+                }
+                let inside = grid.cell_of(fluid.position(i)) != OUTSIDE;
+                lost += usize::from(!inside);
+                inside.then_some(id)
             })
             .collect();
-        compact(fluid, &inside);
+        compact(fluid, &kept);
         let mut walls = walls.filter(|w| !w.rho.is_empty());
         if let Some(tolerance) = rebalance {
             let before = self.slabs.clone();
