@@ -60,6 +60,91 @@ pub enum ConfigError {
 
 const DOF_NAMES: &str = "x, y, z, roll, pitch, yaw";
 
+/// An opening in a floating body's walls (see [`sph::body::OpeningSpec`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OpeningCfg {
+    /// m, box coordinates (origin at the centre of the box's bottom face).
+    pub centre: [f64; 3],
+    /// m, extent along x, y, z.
+    pub size: [f64; 3],
+}
+
+/// A spring holding a floating body (see [`sph::body::SpringSpec`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringCfg {
+    /// m, box coordinates.
+    pub attach: [f64; 3],
+    /// m, tank frame.
+    pub anchor: [f64; 3],
+    /// N/m (2D: per metre of breadth).
+    pub stiffness: f64,
+    #[serde(default)]
+    pub rest_length: f64,
+}
+
+/// A floating body under `bodies.NAME` (see [`sph::body::BodySpec`]); openings and springs are maps by
+/// name, as ROS 2 parameters nest.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyCfg {
+    pub size: [f64; 3],
+    pub wall_thickness: f64,
+    pub position: [f64; 3],
+    pub mass: f64,
+    pub inertia: [f64; 3],
+    pub centre_of_gravity: [f64; 3],
+    /// m/s and rad/s at the start (free decay).
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(default)]
+    pub angular_velocity: [f64; 3],
+    #[serde(default)]
+    pub fixed: Vec<sph::body::Dof>,
+    #[serde(default)]
+    pub openings: std::collections::BTreeMap<String, OpeningCfg>,
+    #[serde(default)]
+    pub springs: std::collections::BTreeMap<String, SpringCfg>,
+}
+
+impl BodyCfg {
+    fn spec(&self, name: &str) -> sph::body::BodySpec {
+        sph::body::BodySpec {
+            name: name.to_string(),
+            size: self.size,
+            wall_thickness: self.wall_thickness,
+            position: self.position,
+            mass: self.mass,
+            inertia: self.inertia,
+            centre_of_gravity: self.centre_of_gravity,
+            velocity: self.velocity,
+            angular_velocity: self.angular_velocity,
+            fixed: self.fixed.clone(),
+            openings: self
+                .openings
+                .iter()
+                .map(|(n, o)| sph::body::OpeningSpec {
+                    name: n.clone(),
+                    centre: o.centre,
+                    size: o.size,
+                })
+                .collect(),
+            springs: self
+                .springs
+                .iter()
+                .map(|(n, k)| sph::body::SpringSpec {
+                    name: n.clone(),
+                    attach: k.attach,
+                    anchor: k.anchor,
+                    stiffness: k.stiffness,
+                    rest_length: k.rest_length,
+                })
+                .collect(),
+        }
+    }
+}
+
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Probes {
@@ -167,6 +252,9 @@ pub struct RunConfig {
     pub probes: Probes,
     #[serde(default)]
     pub pressure_sensors: Sensors,
+    /// Floating bodies by name (the tank is then the basin around them).
+    #[serde(default)]
+    pub bodies: std::collections::BTreeMap<String, BodyCfg>,
     /// Rows per simulated second in the outputs.
     #[serde(default = "default_rate")]
     pub output_rate_hz: f64,
@@ -616,6 +704,7 @@ impl Loaded {
                 }
             }
         }
+        let bodies = c.bodies.iter().map(|(n, b)| b.spec(n)).collect();
         let p = SimParams {
             dimension: c.dimension,
             tank: c.tank.clone(),
@@ -629,6 +718,7 @@ impl Loaded {
             solver: c.solver.clone(),
             probes,
             pressure_sensors: sensors,
+            bodies,
         };
         p.validate()
             .map_err(|e| key_err(src, &e.field, e.message))?;

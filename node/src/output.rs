@@ -1,4 +1,5 @@
-//! Run outputs: `probes.csv`, `wrench.csv`, `pressure.csv` (a row per output time) and `summary.json`.
+//! Run outputs: `probes.csv`, `wrench.csv`, `pressure.csv` (a row per output time), `bodies.csv` (a row
+//! per floating body and output time, if the case has bodies) and `summary.json`.
 //! Rows are flushed as they are written, so a run that fails keeps everything up to the failure.
 
 use sph::observe::Observation;
@@ -11,8 +12,14 @@ pub struct CsvOutputs {
     probes: BufWriter<File>,
     wrench: BufWriter<File>,
     pressure: BufWriter<File>,
+    bodies: Option<BufWriter<File>>,
     dir: PathBuf,
 }
+
+/// Columns of `bodies.csv`: the body's centre of gravity, orientation (rad), velocities, the liquid's force
+/// and moment about the centre of gravity, and the liquid inside it (2D: per metre of breadth).
+pub const BODY_COLUMNS: &str =
+    "time,body,x,y,z,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,fx,fy,fz,mx,my,mz,flooded_volume,inflow_rate";
 
 fn create(dir: &Path, name: &str, header: &str) -> std::io::Result<BufWriter<File>> {
     let path = dir.join(name);
@@ -53,6 +60,11 @@ impl CsvOutputs {
                         .collect(),
                 ),
             )?,
+            bodies: if params.bodies.is_empty() {
+                None
+            } else {
+                Some(create(dir, "bodies.csv", BODY_COLUMNS)?)
+            },
             dir: dir.to_path_buf(),
         })
     }
@@ -77,12 +89,33 @@ impl CsvOutputs {
             &mut o.wrench.force.iter().chain(o.wrench.moment.iter()).copied(),
         )?;
         row(&mut self.pressure, &mut o.pressures.iter().copied())?;
+        if let Some(w) = &mut self.bodies {
+            for b in &o.bodies {
+                write!(w, "{:.6},{}", o.time, b.name)?;
+                for v in b
+                    .position
+                    .iter()
+                    .chain(&b.roll_pitch_yaw)
+                    .chain(&b.velocity)
+                    .chain(&b.angular_velocity)
+                    .chain(&b.force)
+                    .chain(&b.moment)
+                    .chain([&b.flooded_volume, &b.inflow_rate])
+                {
+                    write!(w, ",{v:.6e}")?;
+                }
+                writeln!(w)?;
+            }
+        }
         Ok(())
     }
 
     pub fn flush(&mut self) -> std::io::Result<()> {
         self.probes.flush()?;
         self.wrench.flush()?;
+        if let Some(w) = &mut self.bodies {
+            w.flush()?;
+        }
         self.pressure.flush()
     }
 }

@@ -18,6 +18,8 @@ pub enum SimError {
     AllParticlesLost { time: f64 },
     #[error("cannot spread the simulation over MPI ranks: {0}")]
     Decomposition(String),
+    #[error("floating body `{name}` left the tank at t = {time:.6} s: keep it clear of the walls (a larger tank, springs or fixed degrees of freedom)")]
+    BodyLeftTank { name: String, time: f64 },
     #[error("the motion ends at t = {end:.6} s but the run was asked to go on to t = {time:.6} s: shorten --duration or extend the motion")]
     MotionEnded { time: f64, end: f64 },
 }

@@ -18,6 +18,7 @@
 //!     solver: SolverSpec::default(),
 //!     probes: vec![ProbeSpec { name: "mid".into(), x: 0.0, y: 0.0 }],
 //!     pressure_sensors: vec![],
+//!     bodies: vec![],
 //! };
 //! let mut sim = build(params).unwrap();
 //! sim.advance_to(&AtRest, 0.01).unwrap();
@@ -28,6 +29,7 @@
 // to catch NaN along with negatives.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod body;
 pub mod boundary;
 pub mod domain;
 pub mod eos;

@@ -270,6 +270,9 @@ pub struct SimParams {
     pub solver: SolverSpec,
     pub probes: Vec<ProbeSpec>,
     pub pressure_sensors: Vec<SensorSpec>,
+    /// Floating bodies in the tank (which then serves as the basin around them).
+    #[serde(default)]
+    pub bodies: Vec<crate::body::BodySpec>,
 }
 
 /// A parameter that cannot be used, with the field's dotted name and what would be accepted.
@@ -338,6 +341,54 @@ impl SimParams {
         } else {
             (2.0 * self.solver.smoothing_ratio).ceil() as u32
         }
+    }
+
+    /// Floating bodies need the symplectic WCSPH scheme with wall particle layers, each checked against the
+    /// tank.
+    fn validate_bodies(&self) -> Result<(), ParamError> {
+        let Some(first) = self.bodies.first() else {
+            return Ok(());
+        };
+        let s = &self.solver;
+        let field = format!("bodies.{}", first.name);
+        if s.scheme != Scheme::Wcsph {
+            return Err(err(
+                &field,
+                "floating bodies run with solver.scheme: wcsph (dfsph does not move bodies yet)",
+            ));
+        }
+        if s.integrator != Integrator::Symplectic {
+            return Err(err(&field, "floating bodies are integrated with the liquid's symplectic steps: set solver.integrator: symplectic"));
+        }
+        if s.boundary.method != BoundaryMethod::Dynamic {
+            return Err(err(
+                &field,
+                "floating bodies are made of wall particles: set solver.boundary.method: dynamic",
+            ));
+        }
+        let support = 2.0 * self.h();
+        let lo = [-self.tank.length / 2.0, -self.tank.breadth / 2.0, 0.0];
+        let hi = [
+            self.tank.length / 2.0,
+            self.tank.breadth / 2.0,
+            self.tank.height,
+        ];
+        for (i, b) in self.bodies.iter().enumerate() {
+            if b.name.is_empty()
+                || b.name.contains(',')
+                || self.bodies[..i].iter().any(|o| o.name == b.name)
+            {
+                return Err(err(
+                    "bodies",
+                    format!(
+                        "body names must be non-empty, unique and free of commas, got `{}`",
+                        b.name
+                    ),
+                ));
+            }
+            b.validate(self.dimension, lo, hi, self.particle_spacing, support)?;
+        }
+        Ok(())
     }
 
     /// Checks every field; the error names the first unusable one.
@@ -467,6 +518,7 @@ impl SimParams {
             s.artificial_viscosity.boundary_factor,
         )?;
         non_negative("solver.density_diffusion.delta", s.density_diffusion.delta)?;
+        self.validate_bodies()?;
         non_negative("solver.dt_min", s.dt_min)?;
         positive("solver.dt_max", s.dt_max)?;
         if s.verlet_reset_steps == 0 {

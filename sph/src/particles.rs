@@ -8,6 +8,9 @@ use crate::neighbours::{counting_sort, order_cells_by, permute, Grid, OUTSIDE};
 /// for its neighbours' sums and left out of every total.
 pub const HALO: u32 = 1 << 31;
 
+/// The tag of a boundary particle that belongs to the tank (not to a floating body).
+pub const NOT_BODY: u32 = u32::MAX;
+
 /// The liquid.
 #[derive(Clone, Debug)]
 pub struct Fluid<const D: usize> {
@@ -95,6 +98,7 @@ impl<const D: usize> Default for Boundary<D> {
             cell: Vec::new(),
             starts: Vec::new(),
             drho: Vec::new(),
+            tag: Vec::new(),
         }
     }
 }
@@ -231,6 +235,9 @@ pub struct Boundary<const D: usize> {
     pub cell: Vec<u32>,
     pub starts: Vec<u32>,
     pub drho: Vec<f32>,
+    /// Body particle index of a floating body's particle, [`NOT_BODY`] for the tank's (kept through
+    /// sorting).
+    pub tag: Vec<u32>,
 }
 
 impl<const D: usize> Boundary<D> {
@@ -252,6 +259,7 @@ impl<const D: usize> Boundary<D> {
         self.r.clear();
         self.p.clear();
         self.pr2.clear();
+        self.tag.clear();
     }
 
     pub fn push(&mut self, x: [f64; D], v: [f64; D], rho: f64, p: f32) {
@@ -264,10 +272,12 @@ impl<const D: usize> Boundary<D> {
         self.r.push(rho as f32);
         self.p.push(p);
         self.pr2.push(p / (rho * rho) as f32);
+        self.tag.push(NOT_BODY);
     }
 
-    /// Sorts by cell (points off the grid are dropped: they cannot reach any fluid particle).
-    pub fn sort(&mut self, grid: &Grid<D>, scratch: &mut SortScratch) {
+    /// Sorts by cell (points off the grid are dropped: they cannot reach any fluid particle); returns how
+    /// many were dropped.
+    pub fn sort(&mut self, grid: &Grid<D>, scratch: &mut SortScratch) -> usize {
         let n = self.len();
         let mut cells = std::mem::take(&mut self.cell);
         cells.clear();
@@ -291,6 +301,8 @@ impl<const D: usize> Boundary<D> {
         permute(&mut self.rho, dest, &mut scratch.f64s, keep);
         permute(&mut self.rho0, dest, &mut scratch.f64s, keep);
         permute(&mut self.cell, dest, &mut scratch.u32s, keep);
+        permute(&mut self.tag, dest, &mut scratch.u32s, keep);
         self.drho.resize(keep, 0.0);
+        n - keep
     }
 }

@@ -4,6 +4,7 @@
 //! R^T (g − a) and the rotation terms (Euler, centrifugal, Coriolis), so the result does not depend on where
 //! the tank is in the world, and positions keep their precision relative to the tank origin.
 
+use crate::body::{coupling, shell, BodyState, RigidBody};
 use crate::boundary::{dynamic, mirror};
 use crate::domain::{Comm, Domain, Op};
 use crate::eos::Tait;
@@ -86,6 +87,8 @@ pub struct Simulation<const D: usize, K: Kernel> {
     impulse_time: f64,
     /// This rank's part of a decomposition over several processes (MPI), if any.
     dom: Option<Domain>,
+    /// Floating bodies (their particles are among `bound`).
+    bodies: crate::body::Bodies,
 }
 
 impl<const D: usize, K: Kernel> Simulation<D, K> {
@@ -116,7 +119,21 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let grid = Grid::new(lo, hi, 0.5 * support);
 
         // Liquid at rest with hydrostatic pressure below its own top.
-        let (points, volume) = fluid_lattice::<D>(&params);
+        let (mut points, volume) = fluid_lattice::<D>(&params);
+        // Floating bodies start where their box and half a spacing around it hold no liquid (liquid exactly
+        // half a spacing off a face stays: one spacing from the body's outer particles, as at a wall).
+        let mut bodies = crate::body::Bodies::default();
+        let mut body_points: Vec<Vec<[f64; 3]>> = Vec::new();
+        for spec in &params.bodies {
+            let pts = shell::wall_points(spec, D, dp);
+            points.retain(|x| {
+                let x = to3(*x);
+                let b = std::array::from_fn(|k| x[k] - spec.position[k]);
+                !shell::covers(spec, D, b, 0.499 * dp)
+            });
+            bodies.list.push(RigidBody::new(spec, D, &pts));
+            body_points.push(pts);
+        }
         let (g, top) = (params.gravity, params.fill.height);
         let fill_x1 = tank.lo[0] + params.fill_length();
         let hydro = move |x: [f64; D]| -> f64 {
@@ -136,7 +153,22 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             BoundaryMethod::Dynamic => dynamic::build(&wall_pts, hydro, &eos),
             BoundaryMethod::Mirror => Boundary::default(),
         };
-        bound.sort(&grid, &mut scratch);
+        for (b, (spec, pts)) in params.bodies.iter().zip(&body_points).enumerate() {
+            for (i, p) in pts.iter().enumerate() {
+                let x: [f64; D] = from3(std::array::from_fn(|k| p[k] + spec.position[k]));
+                let rho = hydro(x).max(rho0);
+                bound.push(x, [0.0; D], rho, eos.pressure(rho as f32));
+                *bound.tag.last_mut().expect("just pushed") = bodies.which.len() as u32;
+                bodies.which.push((b as u32, i as u32));
+            }
+        }
+        if bound.sort(&grid, &mut scratch) > 0 && !bodies.is_empty() {
+            return Err(SimError::BodyLeftTank {
+                name: params.bodies[0].name.clone(),
+                time: 0.0,
+            });
+        }
+        bodies.reindex(&bound);
         let (shell_pts, shell_volume) = wall_lattice::<D>(&params, shell_layers);
         let mut shell = Shell {
             points: dynamic::build(&shell_pts, |_| rho0, &eos),
@@ -149,6 +181,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         };
         let dom = match comm.filter(|c| c.size() > 1) {
             None => None,
+            Some(_) if !bodies.is_empty() => {
+                return Err(SimError::Decomposition(
+                    "floating bodies run in one process: start it without mpirun".into(),
+                ))
+            }
             Some(c) => {
                 // Mirror ghosts are rebuilt from where particles are mid-step, which may be a column
                 // beyond where they were sorted: one more halo column brings their sources.
@@ -202,7 +239,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         } else {
             1e-4 * s.cfl * h / c0
         };
-        Ok(Self {
+        let mut sim = Self {
             params,
             kernel,
             coef,
@@ -228,7 +265,12 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             impulse: PassTotals::default(),
             impulse_time: 0.0,
             dom,
-        })
+            bodies,
+        };
+        if !sim.bodies.is_empty() {
+            sim.bodies.last_flooded = Some((0.0, sim.flooded_volumes()));
+        }
+        Ok(sim)
     }
 
     /// One step of the divergence-free scheme (see [`dfsph`]).
@@ -376,6 +418,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         }
         let eos = self.eos;
         self.fluid.refresh(|r, _| eos.pressure(r));
+        if !self.bodies.is_empty() {
+            self.place_bodies(t)?;
+        }
         match self.params.solver.boundary.method {
             BoundaryMethod::Dynamic => dynamic::refresh(&mut self.bound, &eos),
             BoundaryMethod::Mirror => {
@@ -413,6 +458,21 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 self.dom.as_ref().map(|d| d.slabs.columns(d.comm.rank())),
             );
         }
+        if !self.bodies.is_empty() {
+            coupling::liquid_forces(
+                &self.kernel,
+                &self.coef,
+                &self.grid,
+                &self.fluid,
+                &self.bound,
+                &self.bodies.slots,
+                &mut self.bodies.forces,
+            );
+            let wrenches = self.bodies.sum_forces();
+            for (body, (f, m)) in self.bodies.list.iter_mut().zip(wrenches) {
+                body.accelerate(f, m, &frame);
+            }
+        }
         self.stats.force_evaluations += 1;
         if self.last.non_finite {
             return Err(SimError::NonFinite {
@@ -420,6 +480,24 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 step: self.stats.steps,
             });
         }
+        Ok(())
+    }
+
+    /// Moves the bodies' particles to where the bodies are and sorts the boundary particles again.
+    fn place_bodies(&mut self, t: f64) -> Result<(), SimError> {
+        self.bodies.place(&mut self.bound);
+        let before = self.bound.len();
+        self.bound.sort(&self.grid, &mut self.scratch);
+        if self.bound.len() < before {
+            let lost = (0..self.bodies.which.len() as u32)
+                .find(|g| !self.bound.tag.contains(g))
+                .map_or(0, |g| self.bodies.which[g as usize].0 as usize);
+            return Err(SimError::BodyLeftTank {
+                name: self.bodies.list[lost].name.clone(),
+                time: t,
+            });
+        }
+        self.bodies.reindex(&self.bound);
         Ok(())
     }
 
@@ -534,6 +612,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                     walls.then_some(&mut self.bound),
                     dt,
                 );
+                for b in &mut self.bodies.list {
+                    b.predict(dt);
+                }
                 if walls {
                     dynamic::clamp(&mut self.bound, self.eos.rho0 as f64);
                 }
@@ -543,6 +624,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                     walls.then_some(&mut self.bound),
                     dt,
                 );
+                for b in &mut self.bodies.list {
+                    b.correct(dt);
+                }
             }
             Integrator::Verlet => {
                 let euler = self
@@ -676,18 +760,82 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             self.impulse_time = 0.0;
             f
         } else {
-            (self.last.force, self.last.moment)
+            // The tank's walls alone: the force of all boundary particles on the liquid, less the bodies'
+            // (the reaction of the liquid's force on them).
+            let b = &self.bodies;
+            (
+                std::array::from_fn(|k| self.last.force[k] + b.total_force[k]),
+                std::array::from_fn(|k| self.last.moment[k] + b.total_moment[k]),
+            )
         };
         let wrench = Wrench {
             force: force.map(|v| v * scale),
             moment: moment.map(|v| v * scale),
         };
+        let bodies = self.body_states();
         Ok(Observation {
             time: self.time,
             probes,
             pressures,
             wrench,
+            bodies,
         })
+    }
+
+    /// The liquid in each body's hollow, m³ (2D: m² = m³ per metre of breadth).
+    fn flooded_volumes(&self) -> Vec<f64> {
+        let cell = self.coef.m_fluid as f64 / self.coef.rho0 as f64;
+        self.bodies
+            .list
+            .iter()
+            .map(|b| {
+                let n = (0..self.fluid.len())
+                    .filter(|&i| {
+                        let x = to3(self.fluid.position(i));
+                        b.inside(nalgebra::Vector3::from(x), D)
+                    })
+                    .count();
+                n as f64 * cell
+            })
+            .collect()
+    }
+
+    /// Each body's motion, the liquid's force on it and the liquid inside it now (2D: per metre of breadth).
+    fn body_states(&mut self) -> Vec<BodyState> {
+        if self.bodies.is_empty() {
+            return Vec::new();
+        }
+        let flooded = self.flooded_volumes();
+        let rates: Vec<f64> = match &self.bodies.last_flooded {
+            Some((t0, v0)) if self.time > *t0 => flooded
+                .iter()
+                .zip(v0)
+                .map(|(v, v0)| (v - v0) / (self.time - t0))
+                .collect(),
+            _ => vec![0.0; flooded.len()],
+        };
+        self.bodies.last_flooded = Some((self.time, flooded.clone()));
+        self.bodies
+            .list
+            .iter()
+            .zip(flooded.iter().zip(rates))
+            .map(|(b, (&flooded_volume, inflow_rate))| {
+                let q = nalgebra::UnitQuaternion::from_rotation_matrix(&b.now.rot);
+                let (roll, pitch, yaw) = b.now.rot.euler_angles();
+                BodyState {
+                    name: b.name.clone(),
+                    position: b.now.cog.into(),
+                    quaternion: [q.i, q.j, q.k, q.w],
+                    roll_pitch_yaw: [roll, pitch, yaw],
+                    velocity: b.now.vel.into(),
+                    angular_velocity: b.now.omega.into(),
+                    force: b.liquid_force.into(),
+                    moment: b.liquid_moment.into(),
+                    flooded_volume,
+                    inflow_rate,
+                }
+            })
+            .collect()
     }
 
     pub fn time(&self) -> f64 {

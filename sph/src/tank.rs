@@ -135,6 +135,7 @@ mod tests {
             solver: SolverSpec::default(),
             probes: vec![],
             pressure_sensors: vec![],
+            bodies: vec![],
         }
     }
 

@@ -50,6 +50,7 @@ fn case(scheme: Scheme, method: BoundaryMethod) -> SimParams {
                 z,
             })
             .collect(),
+        bodies: vec![],
     }
 }
 

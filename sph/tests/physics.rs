@@ -30,6 +30,7 @@ fn tank2d(length: f64, height: f64, fill: f64, dp: f64) -> SimParams {
         solver: SolverSpec::default(),
         probes: vec![],
         pressure_sensors: vec![],
+        bodies: vec![],
     }
 }
 

@@ -50,4 +50,6 @@ pub struct Observation {
     /// Gauge pressure at each sensor, Pa (0 where the sensor is dry).
     pub pressures: Vec<f64>,
     pub wrench: Wrench,
+    /// Floating bodies, in the order of the parameters.
+    pub bodies: Vec<crate::body::BodyState>,
 }

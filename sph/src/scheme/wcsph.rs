@@ -349,7 +349,8 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
     total
 }
 
-/// Density rate of dynamic wall particles by continuity with the liquid (walls at rest in the tank frame);
+/// Density rate of dynamic wall particles by continuity with the liquid (walls move with their velocities:
+/// at rest in the tank frame, or with a floating body);
 /// with `columns`, only of the walls in those grid columns (a subdomain's own), the others get 0.
 pub fn wall_density_rates<const D: usize, K: Kernel>(
     k: &K,
@@ -361,11 +362,12 @@ pub fn wall_density_rates<const D: usize, K: Kernel>(
 ) {
     let Boundary {
         x: bx,
+        v: bv,
         cell: bcell,
         drho,
         ..
     } = bound;
-    let (bx, bcell) = (&*bx, &*bcell);
+    let (bx, bv, bcell) = (&*bx, &*bv, &*bcell);
     drho.par_chunks_mut(CHUNK)
         .enumerate()
         .for_each(|(ci, chunk)| {
@@ -380,6 +382,7 @@ pub fn wall_density_rates<const D: usize, K: Kernel>(
                     }
                 }
                 let xb: [f32; D] = std::array::from_fn(|d| bx[d][b]);
+                let vb: [f32; D] = std::array::from_fn(|d| bv[d][b]);
                 let n = grid.ranges(bcell[b], &fluid.starts, &mut fr);
                 let mut s = 0.0f32;
                 for &(lo, hi) in &fr[..n] {
@@ -389,7 +392,7 @@ pub fn wall_density_rates<const D: usize, K: Kernel>(
                         for d in 0..D {
                             let dx = xb[d] - fluid.x[d][j];
                             r2 += dx * dx;
-                            vr -= fluid.v[d][j] * dx;
+                            vr += (vb[d] - fluid.v[d][j]) * dx;
                         }
                         if r2 < c.support2 {
                             s += vr * k.grad_factor(r2.sqrt());

@@ -1,0 +1,68 @@
+//! The liquid's force on each particle of a floating body: the reaction of the pressure and viscous terms the
+//! body's particles put on the liquid in [`crate::scheme::wcsph`], pair by pair, so the liquid and the bodies
+//! exchange equal and opposite forces.
+
+use crate::kernel::Kernel;
+use crate::neighbours::{Grid, NO_RANGES};
+use crate::particles::{Boundary, Fluid};
+use crate::scheme::wcsph::Coefficients;
+use crate::tank::to3;
+use rayon::prelude::*;
+
+/// Force of the liquid on the boundary particles at `slots` (x, y, z; per unit breadth in 2D), into `out`.
+pub fn liquid_forces<const D: usize, K: Kernel>(
+    k: &K,
+    c: &Coefficients,
+    grid: &Grid<D>,
+    fluid: &Fluid<D>,
+    bound: &Boundary<D>,
+    slots: &[u32],
+    out: &mut Vec<[f64; 3]>,
+) {
+    slots
+        .par_iter()
+        .map(|&b| {
+            let b = b as usize;
+            let xb: [f32; D] = std::array::from_fn(|d| bound.x[d][b]);
+            let vb: [f32; D] = std::array::from_fn(|d| bound.v[d][b]);
+            let (rb, pb_r2) = (bound.r[b], bound.pr2[b]);
+            let mut ranges = NO_RANGES;
+            let n = grid.ranges(bound.cell[b], &fluid.starts, &mut ranges);
+            let mut force = [0.0f64; D];
+            for &(lo, hi) in &ranges[..n] {
+                for j in lo as usize..hi as usize {
+                    let mut dx = [0.0f32; D];
+                    let mut vd = [0.0f32; D];
+                    let (mut r2, mut vr) = (0.0f32, 0.0f32);
+                    for d in 0..D {
+                        dx[d] = fluid.x[d][j] - xb[d];
+                        vd[d] = fluid.v[d][j] - vb[d];
+                        r2 += dx[d] * dx[d];
+                        vr += vd[d] * dx[d];
+                    }
+                    if r2 >= c.support2 {
+                        continue;
+                    }
+                    let f = k.grad_factor(r2.sqrt());
+                    let ra = fluid.r[j];
+                    let inv_r2e = 1.0 / (r2 + c.eta2);
+                    let mu = c.h * vr.min(0.0) * inv_r2e;
+                    let s = fluid.pr2[j]
+                        + pb_r2
+                        + (-c.alpha_bound * c.c0 * mu + c.beta_bound * mu * mu) * 2.0 / (ra + rb);
+                    let lam = if c.nu4 > 0.0 {
+                        c.m_bound * c.nu4 * f * r2 * inv_r2e / (ra + rb)
+                    } else {
+                        0.0
+                    };
+                    // The acceleration the body particle gives liquid particle j, and its reaction.
+                    for d in 0..D {
+                        let pair = -c.m_bound * s * f * dx[d] + lam * vd[d];
+                        force[d] -= (c.m_fluid * pair) as f64;
+                    }
+                }
+            }
+            to3(force)
+        })
+        .collect_into_vec(out);
+}

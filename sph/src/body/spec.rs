@@ -1,0 +1,219 @@
+//! The description of a floating body: a hollow box of boundary particles with openings (damage), its mass
+//! properties, the degrees of freedom it may use and the springs that hold it.
+//!
+//! Box coordinates: origin at the centre of the box's bottom face, axes parallel to the tank's at the start
+//! (x along `size[0]`, y along `size[1]`, z up). A 2D run uses the x and z parts of every triple, and its
+//! mass, inertia and spring stiffness are per metre of breadth (as the liquid's are).
+
+use crate::params::ParamError;
+use serde::{Deserialize, Serialize};
+
+/// A region of the box's walls left out (a hole): a box in box coordinates.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OpeningSpec {
+    pub name: String,
+    /// Centre, box coordinates, m.
+    pub centre: [f64; 3],
+    /// Extent along x, y, z, m (make it at least the wall thickness across the wall it cuts).
+    pub size: [f64; 3],
+}
+
+/// A linear spring between a point of the body and a fixed anchor (a mooring line).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    pub name: String,
+    /// Where it is attached, box coordinates, m.
+    pub attach: [f64; 3],
+    /// Where it is anchored, tank frame, m.
+    pub anchor: [f64; 3],
+    /// N/m (2D: per metre of breadth).
+    pub stiffness: f64,
+    /// Length at which it pulls nothing, m.
+    #[serde(default)]
+    pub rest_length: f64,
+}
+
+/// A degree of freedom of a body, in the tank's axes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Dof {
+    /// Translations along x, y, z.
+    X,
+    Y,
+    Z,
+    /// Rotations about x, y, z (a 2D run turns about y only).
+    Rx,
+    Ry,
+    Rz,
+}
+
+impl Dof {
+    pub const ALL: [Dof; 6] = [Dof::X, Dof::Y, Dof::Z, Dof::Rx, Dof::Ry, Dof::Rz];
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// A rigid hollow box of boundary particles moved by the liquid (and gravity and springs).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub name: String,
+    /// Outer length (x), breadth (y; unused in 2D) and height (z), m.
+    pub size: [f64; 3],
+    /// Thickness of its walls, m (at least the kernel support, 2h, so no liquid sees through a wall).
+    pub wall_thickness: f64,
+    /// Where the centre of its bottom face starts, tank frame, m.
+    pub position: [f64; 3],
+    /// kg (2D: per metre of breadth).
+    pub mass: f64,
+    /// Moments of inertia about its centre of gravity along the box axes, kg·m² (2D: only the y one is used,
+    /// per metre of breadth).
+    pub inertia: [f64; 3],
+    /// Centre of gravity, box coordinates, m.
+    pub centre_of_gravity: [f64; 3],
+    /// Velocity of the centre of gravity at the start, m/s, and angular velocity, rad/s (tank axes; a free
+    /// decay test starts from one).
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(default)]
+    pub angular_velocity: [f64; 3],
+    /// Degrees of freedom held at their start values.
+    #[serde(default)]
+    pub fixed: Vec<Dof>,
+    #[serde(default)]
+    pub openings: Vec<OpeningSpec>,
+    #[serde(default)]
+    pub springs: Vec<SpringSpec>,
+}
+
+fn err(field: String, message: impl Into<String>) -> ParamError {
+    ParamError {
+        field,
+        message: message.into(),
+    }
+}
+
+fn finite3(field: String, v: &[f64; 3]) -> Result<(), ParamError> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(err(field, format!("element {i} is not a finite number"))),
+        None => Ok(()),
+    }
+}
+
+impl BodySpec {
+    /// Checks the body against the tank (`lo`, `hi`: the tank's inside in x, y, z) and the kernel support;
+    /// errors name the field as `bodies.NAME.field`.
+    pub fn validate(
+        &self,
+        dimension: usize,
+        lo: [f64; 3],
+        hi: [f64; 3],
+        dp: f64,
+        support: f64,
+    ) -> Result<(), ParamError> {
+        let f = |field: &str| format!("bodies.{}.{field}", self.name);
+        let axes: &[usize] = if dimension == 2 { &[0, 2] } else { &[0, 1, 2] };
+        finite3(f("size"), &self.size)?;
+        finite3(f("position"), &self.position)?;
+        finite3(f("inertia"), &self.inertia)?;
+        finite3(f("centre_of_gravity"), &self.centre_of_gravity)?;
+        finite3(f("velocity"), &self.velocity)?;
+        finite3(f("angular_velocity"), &self.angular_velocity)?;
+        for &k in axes {
+            if !(self.size[k] > 0.0) {
+                return Err(err(f("size"), format!("element {k} must be positive")));
+            }
+        }
+        if !(self.mass.is_finite() && self.mass > 0.0) {
+            return Err(err(
+                f("mass"),
+                format!("must be a positive number, got {}", self.mass),
+            ));
+        }
+        let turning: &[usize] = if dimension == 2 { &[1] } else { &[0, 1, 2] };
+        for &k in turning {
+            if !(self.inertia[k] > 0.0) {
+                return Err(err(
+                    f("inertia"),
+                    format!("element {k} must be positive (kg·m² about the centre of gravity)"),
+                ));
+            }
+        }
+        let t = self.wall_thickness;
+        if !(t.is_finite() && t >= support) {
+            return Err(err(
+                f("wall_thickness"),
+                format!(
+                    "{t} m is thinner than the kernel support {support:.4} m: the liquid would see through \
+                     the walls; use at least that (or a smaller particle_spacing)"
+                ),
+            ));
+        }
+        for &k in axes {
+            if 2.0 * t + 2.0 * dp > self.size[k] + 1e-12 {
+                return Err(err(
+                    f("wall_thickness"),
+                    format!(
+                        "{t} m leaves no room inside a box {} m across",
+                        self.size[k]
+                    ),
+                ));
+            }
+        }
+        for &k in axes {
+            let (a, b) = if k == 2 {
+                (self.position[2], self.position[2] + self.size[2])
+            } else {
+                (
+                    self.position[k] - 0.5 * self.size[k],
+                    self.position[k] + 0.5 * self.size[k],
+                )
+            };
+            if a < lo[k] || b > hi[k] {
+                return Err(err(
+                    f("position"),
+                    format!("the box must start inside the tank (axis {k}: {a:.4}..{b:.4} m, tank {:.4}..{:.4} m)", lo[k], hi[k]),
+                ));
+            }
+        }
+        for o in &self.openings {
+            finite3(f(&format!("openings.{}.centre", o.name)), &o.centre)?;
+            finite3(f(&format!("openings.{}.size", o.name)), &o.size)?;
+            if axes.iter().any(|&k| !(o.size[k] > 0.0)) {
+                return Err(err(
+                    f(&format!("openings.{}.size", o.name)),
+                    "every extent must be positive",
+                ));
+            }
+        }
+        for s in &self.springs {
+            finite3(f(&format!("springs.{}.attach", s.name)), &s.attach)?;
+            finite3(f(&format!("springs.{}.anchor", s.name)), &s.anchor)?;
+            if !(s.stiffness.is_finite() && s.stiffness >= 0.0) {
+                return Err(err(
+                    f(&format!("springs.{}.stiffness", s.name)),
+                    format!("must be zero or positive, got {}", s.stiffness),
+                ));
+            }
+            if !(s.rest_length.is_finite() && s.rest_length >= 0.0) {
+                return Err(err(
+                    f(&format!("springs.{}.rest_length", s.name)),
+                    format!("must be zero or positive, got {}", s.rest_length),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether a point in box coordinates lies in one of the openings.
+    pub fn in_opening(&self, p: [f64; 3], dimension: usize) -> bool {
+        self.openings.iter().any(|o| {
+            (0..3)
+                .filter(|&k| dimension == 3 || k != 1)
+                .all(|k| (p[k] - o.centre[k]).abs() <= 0.5 * o.size[k])
+        })
+    }
+}
