@@ -31,6 +31,18 @@ pub const BUILTIN: &[(&str, &str)] = &[
         "spheric10",
         include_str!("../../launch-configs/spheric10.yaml"),
     ),
+    (
+        "flooding_case_a",
+        include_str!("../../launch-configs/flooding_case_a.yaml"),
+    ),
+    (
+        "flooding_case_b",
+        include_str!("../../launch-configs/flooding_case_b.yaml"),
+    ),
+    (
+        "flooding_case_c",
+        include_str!("../../launch-configs/flooding_case_c.yaml"),
+    ),
 ];
 
 #[derive(Debug, thiserror::Error)]

@@ -212,7 +212,8 @@ impl Recorder {
         Ok(())
     }
 
-    /// Records the outputs of one state on `topics` (wrench, probes, pressures) at `log_time`.
+    /// Records the outputs of one state on `topics` (wrench, probes, pressures) at `log_time`, and each
+    /// floating body's on `bodies/NAME/odom` and `bodies/NAME/wrench` beside the wrench topic.
     pub fn write_outputs(
         &mut self,
         topics: &[String; 3],
@@ -221,7 +222,14 @@ impl Recorder {
     ) -> Result<(), RecordError> {
         self.write(&topics[0], log_time, &m.wrench)?;
         self.write(&topics[1], log_time, &m.probes)?;
-        self.write(&topics[2], log_time, &m.pressures)
+        self.write(&topics[2], log_time, &m.pressures)?;
+        let base = topics[0].rsplit_once('/').map_or("", |(ns, _)| ns);
+        for b in &m.bodies {
+            let topic = |what| format!("{base}/{}", crate::ros::node::body_topic(&b.name, what));
+            self.write(&topic("odom"), log_time, &b.odom)?;
+            self.write(&topic("wrench"), log_time, &b.wrench)?;
+        }
+        Ok(())
     }
 
     /// The folder of the bag.

@@ -275,3 +275,16 @@ fn a_failure_stops_all_ranks_and_is_reported_once() {
     assert!(!o.status.success());
     assert!(err.contains("run on at most 7 ranks"), "{err}");
 }
+
+#[test]
+fn floating_bodies_refuse_to_be_spread_over_ranks() {
+    let out = mpirun(2)
+        .args(["run", "flooding_case_a", "--duration", "0.01", "--out"])
+        .arg(common::tmp("mpi_bodies").join("out"))
+        .args(["--set", "particle_spacing=0.0035"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("floating bodies run in one process"), "{err}");
+}

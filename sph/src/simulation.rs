@@ -624,8 +624,17 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                     walls.then_some(&mut self.bound),
                     dt,
                 );
+                let (lo, hi) = (to3(self.tank.lo), to3(self.tank.hi));
+                let axes: &[usize] = if D == 2 { &[0, 2] } else { &[0, 1, 2] };
                 for b in &mut self.bodies.list {
                     b.correct(dt);
+                    // Bodies rest on the tank's walls, their particles a spacing inside the inner faces.
+                    b.contain(
+                        lo.into(),
+                        hi.into(),
+                        self.params.particle_spacing,
+                        axes,
+                    );
                 }
             }
             Integrator::Verlet => {

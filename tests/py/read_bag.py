@@ -34,8 +34,9 @@ def summarize(topic, msg):
     if hasattr(msg, "point_step"):
         return [msg.width, msg.height, msg.point_step]
     if hasattr(msg, "pose") and hasattr(msg, "twist"):
-        p = msg.pose.pose.position
-        return [p.x, p.y, p.z]
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        v, w = msg.twist.twist.linear, msg.twist.twist.angular
+        return [p.x, p.y, p.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z]
     return None
 
 

@@ -90,6 +90,45 @@ pub struct OutputMessages {
     pub wrench: WrenchStamped,
     pub probes: ProbeArray,
     pub pressures: PressureArray,
+    /// Per floating body: its motion and the liquid's force on it.
+    pub bodies: Vec<BodyMessages>,
+}
+
+/// A floating body's outputs: `bodies/NAME/odom` (the pose of its centre of gravity in the tank frame, the
+/// twist in its own axes, as nav_msgs/Odometry has it) and `bodies/NAME/wrench` (the liquid's force and
+/// moment about the centre of gravity, tank axes).
+pub struct BodyMessages {
+    pub name: String,
+    pub odom: Odometry,
+    pub wrench: WrenchStamped,
+}
+
+/// The topic of a body's output `what` (`odom` or `wrench`) beside the tank's outputs.
+pub fn body_topic(name: &str, what: &str) -> String {
+    format!("bodies/{name}/{what}")
+}
+
+fn body_messages(tank_frame: &str, stamp: Time, b: &sph::body::BodyState) -> BodyMessages {
+    let q = b.quaternion;
+    let rot = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
+    let state = sph::motion::RigidState {
+        position: b.position.into(),
+        orientation: rot,
+        velocity: b.velocity.into(),
+        angular_velocity: rot.inverse_transform_vector(&b.angular_velocity.into()),
+        ..sph::motion::RigidState::at_rest()
+    };
+    BodyMessages {
+        name: b.name.clone(),
+        odom: super::motion_pub::odometry(&state, stamp, tank_frame, &b.name),
+        wrench: WrenchStamped {
+            header: header(stamp, tank_frame),
+            wrench: Wrench {
+                force: vec3_msg(b.force.into()),
+                torque: vec3_msg(b.moment.into()),
+            },
+        },
+    }
 }
 
 /// Builds the output messages of an observation at `stamp`.
@@ -127,6 +166,11 @@ pub fn output_messages(
                 .collect(),
             pressures: o.pressures.clone(),
         },
+        bodies: o
+            .bodies
+            .iter()
+            .map(|b| body_messages(tank_frame, stamp, b))
+            .collect(),
     }
 }
 
@@ -386,6 +430,16 @@ pub fn run(
     } else {
         None
     };
+    // Each floating body's motion and the liquid's force on it.
+    let mut pub_bodies: Vec<(Publisher<Odometry>, Publisher<WrenchStamped>)> = Vec::new();
+    if iox.dds_outputs {
+        for b in &params.bodies {
+            pub_bodies.push((
+                super::publisher(&mut node, &names, &body_topic(&b.name, "odom"), &out_qos)?,
+                super::publisher(&mut node, &names, &body_topic(&b.name, "wrench"), &out_qos)?,
+            ));
+        }
+    }
     let pub_diag: Publisher<DiagnosticArray> =
         super::publisher(&mut node, &names, "/diagnostics", &out_qos)?;
     let pub_tf: Publisher<TFMessage> =
@@ -761,6 +815,10 @@ pub fn run(
                         publish(pw, m.wrench, "wrench")?;
                         publish(pp, m.probes, "probes")?;
                         publish(ps, m.pressures, "pressures")?;
+                    }
+                    for (b, (po, pw)) in m.bodies.into_iter().zip(&pub_bodies) {
+                        publish(po, b.odom, "body odom")?;
+                        publish(pw, b.wrench, "body wrench")?;
                     }
                     if let (Some(p), true) = (iox_ports.as_ref(), iox.outputs) {
                         let mut so = crate::iox::outputs_of(base + o.time, &o);

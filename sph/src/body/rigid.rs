@@ -225,6 +225,33 @@ impl RigidBody {
     }
 }
 
+impl RigidBody {
+    /// Keeps the body's particles at least `gap` inside the tank's box (`lo`, `hi`, tank frame) along the
+    /// `axes`: a body that reaches a wall is moved back onto it and loses its velocity into the wall (an
+    /// inelastic contact, without friction or the contact's moment). Returns whether it touched.
+    pub fn contain(&mut self, lo: V3, hi: V3, gap: f64, axes: &[usize]) -> bool {
+        let mut touched = false;
+        for &k in axes {
+            let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
+            for i in 0..self.local.len() {
+                let x = self.now.cog[k] + (self.now.rot * self.local[i])[k];
+                min = min.min(x);
+                max = max.max(x);
+            }
+            if min < lo[k] + gap {
+                self.now.cog[k] += lo[k] + gap - min;
+                self.now.vel[k] = self.now.vel[k].max(0.0);
+                touched = true;
+            } else if max > hi[k] - gap {
+                self.now.cog[k] -= max - (hi[k] - gap);
+                self.now.vel[k] = self.now.vel[k].min(0.0);
+                touched = true;
+            }
+        }
+        touched
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -302,6 +329,28 @@ mod tests {
             (measured / period - 1.0).abs() < 1e-3,
             "{measured} vs {period}"
         );
+    }
+
+    #[test]
+    fn a_falling_body_stops_on_the_floor() {
+        let mut b = RigidBody::new(&spec(), 2, &[[0.0, 0.0, 0.0], [0.05, 0.0, 0.1]]);
+        let frame = FrameTerms {
+            g: [0.0, 0.0, -9.81],
+            ..Default::default()
+        };
+        let (lo, hi) = (V3::new(-1.0, 0.0, 0.0), V3::new(1.0, 0.0, 1.0));
+        let mut touched = false;
+        for _ in 0..1000 {
+            b.accelerate(V3::zeros(), V3::zeros(), &frame);
+            b.predict(1e-3);
+            b.accelerate(V3::zeros(), V3::zeros(), &frame);
+            b.correct(1e-3);
+            touched |= b.contain(lo, hi, 0.01, &[0, 2]);
+        }
+        assert!(touched);
+        // Its lowest particle (the bottom face, 0.05 below the centre of gravity) rests 0.01 above the floor.
+        assert!((b.now.cog.z - 0.06).abs() < 1e-12);
+        assert!(b.now.vel.z.abs() < 0.01);
     }
 
     #[test]
