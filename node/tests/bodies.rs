@@ -99,7 +99,12 @@ fn a_damaged_box_floods_and_its_motion_is_recorded_as_odometry() {
     assert_eq!(rows[0].1[volume], 0.0);
     assert!(last[volume] > 1e-4, "flooded {} m²", last[volume]);
     assert!(rows.iter().all(|r| r.1[rate] >= -1e-3));
-    assert!(last[z] < rows[0].1[z] - 1e-4, "sinks: {} → {}", rows[0].1[z], last[z]);
+    assert!(
+        last[z] < rows[0].1[z] - 1e-4,
+        "sinks: {} → {}",
+        rows[0].1[z],
+        last[z]
+    );
 
     let v = common::read_bag(&bag);
     for reader in ["rosbags", "mcap"] {

@@ -629,12 +629,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 for b in &mut self.bodies.list {
                     b.correct(dt);
                     // Bodies rest on the tank's walls, their particles a spacing inside the inner faces.
-                    b.contain(
-                        lo.into(),
-                        hi.into(),
-                        self.params.particle_spacing,
-                        axes,
-                    );
+                    b.contain(lo.into(), hi.into(), self.params.particle_spacing, axes);
                 }
             }
             Integrator::Verlet => {
