@@ -267,6 +267,9 @@ pub struct RunConfig {
     /// Floating bodies by name (the tank is then the basin around them).
     #[serde(default)]
     pub bodies: std::collections::BTreeMap<String, BodyCfg>,
+    /// A piston wave maker at the tank's −x end.
+    #[serde(default)]
+    pub wave_maker: Option<sph::body::PistonSpec>,
     /// Rows per simulated second in the outputs.
     #[serde(default = "default_rate")]
     pub output_rate_hz: f64,
@@ -731,6 +734,7 @@ impl Loaded {
             probes,
             pressure_sensors: sensors,
             bodies,
+            wave_maker: c.wave_maker.clone(),
         };
         p.validate()
             .map_err(|e| key_err(src, &e.field, e.message))?;

@@ -60,7 +60,7 @@ impl CsvOutputs {
                         .collect(),
                 ),
             )?,
-            bodies: if params.bodies.is_empty() {
+            bodies: if params.bodies.is_empty() && params.wave_maker.is_none() {
                 None
             } else {
                 Some(create(dir, "bodies.csv", BODY_COLUMNS)?)

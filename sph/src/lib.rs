@@ -19,6 +19,7 @@
 //!     probes: vec![ProbeSpec { name: "mid".into(), x: 0.0, y: 0.0 }],
 //!     pressure_sensors: vec![],
 //!     bodies: vec![],
+//!     wave_maker: None,
 //! };
 //! let mut sim = build(params).unwrap();
 //! sim.advance_to(&AtRest, 0.01).unwrap();

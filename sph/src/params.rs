@@ -273,6 +273,9 @@ pub struct SimParams {
     /// Floating bodies in the tank (which then serves as the basin around them).
     #[serde(default)]
     pub bodies: Vec<crate::body::BodySpec>,
+    /// A piston wave maker at the tank's −x end.
+    #[serde(default)]
+    pub wave_maker: Option<crate::body::PistonSpec>,
 }
 
 /// A parameter that cannot be used, with the field's dotted name and what would be accepted.
@@ -346,24 +349,28 @@ impl SimParams {
     /// Floating bodies need the symplectic WCSPH scheme with wall particle layers, each checked against the
     /// tank.
     fn validate_bodies(&self) -> Result<(), ParamError> {
-        let Some(first) = self.bodies.first() else {
-            return Ok(());
+        if let Some(wm) = &self.wave_maker {
+            wm.validate(self.tank.length, self.particle_spacing)?;
+        }
+        let field = match (self.bodies.first(), &self.wave_maker) {
+            (Some(first), _) => format!("bodies.{}", first.name),
+            (None, Some(_)) => "wave_maker".to_string(),
+            (None, None) => return Ok(()),
         };
         let s = &self.solver;
-        let field = format!("bodies.{}", first.name);
         if s.scheme != Scheme::Wcsph {
             return Err(err(
                 &field,
-                "floating bodies run with solver.scheme: wcsph (dfsph does not move bodies yet)",
+                "floating bodies and wave makers run with solver.scheme: wcsph (dfsph does not move them yet)",
             ));
         }
         if s.integrator != Integrator::Symplectic {
-            return Err(err(&field, "floating bodies are integrated with the liquid's symplectic steps: set solver.integrator: symplectic"));
+            return Err(err(&field, "floating bodies and wave makers move with the liquid's symplectic steps: set solver.integrator: symplectic"));
         }
         if s.boundary.method != BoundaryMethod::Dynamic {
             return Err(err(
                 &field,
-                "floating bodies are made of wall particles: set solver.boundary.method: dynamic",
+                "floating bodies and wave makers are made of wall particles: set solver.boundary.method: dynamic",
             ));
         }
         let support = 2.0 * self.h();

@@ -4,7 +4,7 @@
 //! R^T (g − a) and the rotation terms (Euler, centrifugal, Coriolis), so the result does not depend on where
 //! the tank is in the world, and positions keep their precision relative to the tank origin.
 
-use crate::body::{coupling, shell, BodyState, RigidBody};
+use crate::body::{coupling, piston, shell, BodyState, RigidBody};
 use crate::boundary::{dynamic, mirror};
 use crate::domain::{Comm, Domain, Op};
 use crate::eos::Tait;
@@ -132,6 +132,24 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 !shell::covers(spec, D, b, 0.499 * dp)
             });
             bodies.list.push(RigidBody::new(spec, D, &pts));
+            body_points.push(
+                pts.iter()
+                    .map(|p| std::array::from_fn(|k| p[k] + spec.position[k]))
+                    .collect(),
+            );
+        }
+        // A wave maker's plate at the −x end, the liquid in front of it.
+        if let Some(wm) = &params.wave_maker {
+            let thickness = if wm.thickness > 0.0 {
+                wm.thickness
+            } else {
+                layers as f64 * dp
+            };
+            let face = piston::rest_face(wm, tank.lo[0], thickness, dp);
+            let n = ((thickness / dp).round() as usize).max(2);
+            let pts = piston::plate_points(face, n, params.tank.height, params.tank.breadth, D, dp);
+            points.retain(|x| x[0] > face + 0.499 * dp);
+            bodies.list.push(RigidBody::driven("wave_maker", wm, &pts));
             body_points.push(pts);
         }
         let (g, top) = (params.gravity, params.fill.height);
@@ -153,9 +171,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             BoundaryMethod::Dynamic => dynamic::build(&wall_pts, hydro, &eos),
             BoundaryMethod::Mirror => Boundary::default(),
         };
-        for (b, (spec, pts)) in params.bodies.iter().zip(&body_points).enumerate() {
+        for (b, pts) in body_points.iter().enumerate() {
             for (i, p) in pts.iter().enumerate() {
-                let x: [f64; D] = from3(std::array::from_fn(|k| p[k] + spec.position[k]));
+                let x: [f64; D] = from3(*p);
                 let rho = hydro(x).max(rho0);
                 bound.push(x, [0.0; D], rho, eos.pressure(rho as f32));
                 *bound.tag.last_mut().expect("just pushed") = bodies.which.len() as u32;
@@ -164,7 +182,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         }
         if bound.sort(&grid, &mut scratch) > 0 && !bodies.is_empty() {
             return Err(SimError::BodyLeftTank {
-                name: params.bodies[0].name.clone(),
+                name: bodies.list[0].name.clone(),
                 time: 0.0,
             });
         }
@@ -613,7 +631,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                     dt,
                 );
                 for b in &mut self.bodies.list {
-                    b.predict(dt);
+                    b.predict(t, dt);
                 }
                 if walls {
                     dynamic::clamp(&mut self.bound, self.eos.rho0 as f64);
@@ -626,8 +644,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 );
                 let (lo, hi) = (to3(self.tank.lo), to3(self.tank.hi));
                 let axes: &[usize] = if D == 2 { &[0, 2] } else { &[0, 1, 2] };
-                for b in &mut self.bodies.list {
-                    b.correct(dt);
+                for b in self.bodies.list.iter_mut() {
+                    b.correct(t, dt);
+                    if b.is_driven() {
+                        continue;
+                    }
                     // Bodies rest on the tank's walls, their particles a spacing inside the inner faces.
                     b.contain(lo.into(), hi.into(), self.params.particle_spacing, axes);
                 }

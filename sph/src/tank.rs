@@ -136,6 +136,7 @@ mod tests {
             probes: vec![],
             pressure_sensors: vec![],
             bodies: vec![],
+            wave_maker: None,
         }
     }
 

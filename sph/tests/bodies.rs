@@ -38,6 +38,7 @@ fn basin(bodies: Vec<BodySpec>) -> SimParams {
         }],
         pressure_sensors: vec![],
         bodies,
+        wave_maker: None,
     }
 }
 
@@ -221,4 +222,108 @@ fn water_pours_into_a_damaged_box_by_the_orifice_law() {
     }
     let (first, last) = (cds[0], cds[cds.len() - 1]);
     assert!((last / first - 1.0).abs() < 0.25, "Cd {first} then {last}");
+}
+
+#[test]
+fn a_piston_wave_maker_makes_the_waves_of_linear_theory() {
+    // A 2.5 m flume, 0.2 m of water, a piston of 40 mm stroke at 0.8 s (kh = 1.42, λ = 0.89 m), dp = 10 mm.
+    let (h, stroke, period) = (0.2, 0.04, 0.8);
+    let mut p = basin(vec![]);
+    p.tank.length = 2.5;
+    p.tank.height = 0.35;
+    p.fill.height = h;
+    p.particle_spacing = 0.01;
+    p.wave_maker = Some(sph::body::PistonSpec {
+        stroke,
+        period,
+        ramp_time: 2.0 * period,
+        thickness: 0.0,
+    });
+    // A probe 0.6 m in front of the plate's resting face (3 wall layers + half the stroke + dp from the wall).
+    let face = -1.25 + 0.03 + 0.5 * stroke + 0.01;
+    p.probes[0].x = face + 0.6;
+    let mut sim = sph::build(p).expect("valid case");
+    let mut rows = Vec::new();
+    let mut t = 0.0;
+    while t < 4.8 - 1e-9 {
+        t += 0.02;
+        sim.advance_to(&AtRest, t).unwrap();
+        let o = sim.observe(&AtRest).unwrap();
+        if rows.is_empty() {
+            // At rest, the liquid pushes the plate back with its hydrostatic force ρ g h² / 2.
+            let f = o.bodies[0].force[0];
+            println!("plate force at rest {f:.1} N/m");
+            assert!((f / -(RHO * G * h * h / 2.0) - 1.0).abs() < 0.03, "{f}");
+        }
+        rows.push((o.time, o.probes[0]));
+    }
+    assert_eq!(sim.counts().lost, 0);
+    // Two full periods after the ramp and the front have passed, before the far wall's reflection returns.
+    let w: Vec<(f64, f64)> = rows.into_iter().filter(|r| r.0 >= 3.2 - 1e-9).collect();
+    let t: Vec<f64> = w.iter().map(|r| r.0).collect();
+    let eta: Vec<f64> = w.iter().map(|r| r.1).collect();
+    let height =
+        eta.iter().cloned().fold(f64::MIN, f64::max) - eta.iter().cloned().fold(f64::MAX, f64::min);
+    let mean = eta.iter().sum::<f64>() / eta.len() as f64;
+    let (measured_period, n) = crossing_period(&t, &eta, mean);
+    // Biesel: H/S = 2 (cosh 2kh − 1) / (sinh 2kh + 2kh), k from ω² = g k tanh kh.
+    let omega = 2.0 * std::f64::consts::PI / period;
+    let mut k = omega * omega / G;
+    for _ in 0..100 {
+        k = omega * omega / (G * (k * h).tanh());
+    }
+    let biesel = stroke * 2.0 * ((2.0 * k * h).cosh() - 1.0) / ((2.0 * k * h).sinh() + 2.0 * k * h);
+    println!(
+        "wave height {height:.4} m (Biesel {biesel:.4} m, ratio {:.2}), period {measured_period:.3} s from {n} crossings, mean level {mean:.4} m",
+        height / biesel
+    );
+    assert!((height / biesel - 1.0).abs() < 0.2);
+    assert!(n >= 3 && (measured_period / period - 1.0).abs() < 0.03);
+    assert!((mean - h).abs() < 0.002);
+}
+
+#[test]
+fn a_3d_box_floats_level_at_its_draught() {
+    // 6 DOF: a 0.24 m cube at 0.12 m draught in a 0.8 m × 0.6 m basin with 0.25 m of water, dp = 20 mm
+    // (walls of three layers).
+    let (b, draught, dp, depth) = (0.24, 0.12, 0.02, 0.25);
+    let kg = 0.08;
+    let mut p = basin(vec![BodySpec {
+        name: "cube".into(),
+        size: [b, b, b],
+        wall_thickness: 0.06,
+        position: [0.0, 0.0, depth - draught],
+        mass: RHO * b * b * draught,
+        inertia: [0.1; 3],
+        centre_of_gravity: [0.0, 0.0, kg],
+        velocity: [0.0; 3],
+        angular_velocity: [0.0; 3],
+        fixed: vec![],
+        openings: vec![],
+        springs: vec![],
+    }]);
+    p.dimension = 3;
+    p.tank = TankSpec {
+        length: 0.8,
+        breadth: 0.6,
+        height: 0.5,
+    };
+    p.fill.height = depth;
+    p.particle_spacing = dp;
+    let m = p.bodies[0].mass;
+    let (sim, rows) = run(p, 0.3, 0.02);
+    assert_eq!(sim.counts().lost, 0);
+    let z_eq = depth - draught + kg;
+    let lift = rows.iter().map(|r| r.2.force[2]).sum::<f64>() / rows.len() as f64;
+    let worst = |f: &dyn Fn(&Row) -> f64| rows.iter().map(f).fold(0.0f64, |a, v| a.max(v.abs()));
+    let dz = worst(&|r| r.2.position[2] - z_eq);
+    let drift = worst(&|r| r.2.position[0].hypot(r.2.position[1]));
+    let tilt = worst(&|r| r.2.roll_pitch_yaw[0].abs().max(r.2.roll_pitch_yaw[1].abs()));
+    println!(
+        "3D: mean lift {lift:.1} N for {:.1} N of weight, height within {dz:.4} m of the hydrostatic, drift {drift:.4} m, tilt {:.2}°",
+        m * G,
+        tilt.to_degrees()
+    );
+    assert!((lift / (m * G) - 1.0).abs() < 0.1);
+    assert!(dz < dp && drift < 0.1 * dp && tilt < 1f64.to_radians());
 }

@@ -51,6 +51,7 @@ fn case(scheme: Scheme, method: BoundaryMethod) -> SimParams {
             })
             .collect(),
         bodies: vec![],
+        wave_maker: None,
     }
 }
 

@@ -31,6 +31,7 @@ fn tank2d(length: f64, height: f64, fill: f64, dp: f64) -> SimParams {
         probes: vec![],
         pressure_sensors: vec![],
         bodies: vec![],
+        wave_maker: None,
     }
 }
 

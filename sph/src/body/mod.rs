@@ -4,10 +4,12 @@
 //! force and moment on each body ([`coupling`]) and integrated with its mass and inertia ([`rigid`]).
 
 pub mod coupling;
+pub mod piston;
 pub mod rigid;
 pub mod shell;
 pub mod spec;
 
+pub use piston::PistonSpec;
 pub use rigid::RigidBody;
 pub use spec::{BodySpec, Dof, OpeningSpec, SpringSpec};
 

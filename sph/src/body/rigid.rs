@@ -6,6 +6,7 @@
 //! absolute angular velocity): I dΩ/dt + Ω × I Ω = M about the centre of gravity, so
 //! dω/dt = I⁻¹ (M − Ω × I Ω) − ω̇_frame − ω_frame × ω. Fixed degrees of freedom get no acceleration.
 
+use super::piston::PistonSpec;
 use super::spec::{BodySpec, Dof};
 use crate::scheme::FrameTerms;
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -57,6 +58,8 @@ pub struct RigidBody {
     /// The liquid's force on the body and its moment about the centre of gravity (last evaluation).
     pub liquid_force: V3,
     pub liquid_moment: V3,
+    /// A wave maker's plate: moved along x by its piston from the rest position of its centre, not by forces.
+    drive: Option<(PistonSpec, f64)>,
 }
 
 /// The 3-vector of a D-dimensional point (y = 0 in 2D), and back.
@@ -117,7 +120,54 @@ impl RigidBody {
             alpha: V3::zeros(),
             liquid_force: V3::zeros(),
             liquid_moment: V3::zeros(),
+            drive: None,
         }
+    }
+
+    /// A wave maker's plate of `points` (tank frame) driven by `piston`.
+    pub fn driven(name: &str, piston: &PistonSpec, points: &[[f64; 3]]) -> Self {
+        let n = points.len().max(1) as f64;
+        let centre = points.iter().fold(V3::zeros(), |c, p| c + v3(*p)) / n;
+        let pose = Pose {
+            cog: centre,
+            rot: Rotation3::identity(),
+            vel: V3::zeros(),
+            omega: V3::zeros(),
+        };
+        Self {
+            name: name.to_string(),
+            mass: 1.0,
+            inertia: Matrix3::identity(),
+            free: [false; 6],
+            springs: Vec::new(),
+            cog_box: V3::zeros(),
+            // No hollow: nothing floods it.
+            inner: (V3::repeat(1.0), V3::repeat(-1.0)),
+            local: points.iter().map(|p| v3(*p) - centre).collect(),
+            now: pose,
+            start: pose,
+            acc: V3::zeros(),
+            alpha: V3::zeros(),
+            liquid_force: V3::zeros(),
+            liquid_moment: V3::zeros(),
+            drive: Some((piston.clone(), centre.x)),
+        }
+    }
+
+    /// Whether the body follows a prescribed motion (a wave maker) instead of forces.
+    pub fn is_driven(&self) -> bool {
+        self.drive.is_some()
+    }
+
+    /// A driven body's pose at time t.
+    fn drive_to(&mut self, t: f64) -> bool {
+        let Some((piston, x0)) = &self.drive else {
+            return false;
+        };
+        let (x, v) = piston.displacement(t);
+        self.now.cog.x = x0 + x;
+        self.now.vel.x = v;
+        true
     }
 
     /// Position and velocity of particle i in the tank frame.
@@ -200,9 +250,12 @@ impl RigidBody {
         self.alpha = alpha;
     }
 
-    /// Saves the state and advances it half a step with the accelerations of the state.
-    pub fn predict(&mut self, dt: f64) {
+    /// Saves the state (at time t) and advances it half a step with the accelerations of the state.
+    pub fn predict(&mut self, t: f64, dt: f64) {
         self.start = self.now;
+        if self.drive_to(t + 0.5 * dt) {
+            return;
+        }
         let h = 0.5 * dt;
         let p = &mut self.now;
         p.cog += h * p.vel;
@@ -211,8 +264,11 @@ impl RigidBody {
         p.omega += h * self.alpha;
     }
 
-    /// Completes the step from the accelerations at the half step.
-    pub fn correct(&mut self, dt: f64) {
+    /// Completes the step (from t) from the accelerations at the half step.
+    pub fn correct(&mut self, t: f64, dt: f64) {
+        if self.drive_to(t + dt) {
+            return;
+        }
         let s = self.start;
         let vel = s.vel + dt * self.acc;
         let omega = s.omega + dt * self.alpha;
@@ -283,9 +339,9 @@ mod tests {
         let dt = 0.01;
         for _ in 0..100 {
             b.accelerate(V3::zeros(), V3::zeros(), &frame);
-            b.predict(dt);
+            b.predict(0.0, dt);
             b.accelerate(V3::zeros(), V3::zeros(), &frame);
-            b.correct(dt);
+            b.correct(0.0, dt);
         }
         // z = z0 − g t²/2 exactly for a constant acceleration.
         let g = 9.81f32 as f64;
@@ -314,9 +370,9 @@ mod tests {
         let mut prev = b.now.cog.x;
         while t < 3.0 * period {
             b.accelerate(V3::zeros(), V3::zeros(), &frame);
-            b.predict(dt);
+            b.predict(0.0, dt);
             b.accelerate(V3::zeros(), V3::zeros(), &frame);
-            b.correct(dt);
+            b.correct(0.0, dt);
             t += dt;
             let x = b.now.cog.x;
             if prev > 0.0 && x <= 0.0 {
@@ -342,9 +398,9 @@ mod tests {
         let mut touched = false;
         for _ in 0..1000 {
             b.accelerate(V3::zeros(), V3::zeros(), &frame);
-            b.predict(1e-3);
+            b.predict(0.0, 1e-3);
             b.accelerate(V3::zeros(), V3::zeros(), &frame);
-            b.correct(1e-3);
+            b.correct(0.0, 1e-3);
             touched |= b.contain(lo, hi, 0.01, &[0, 2]);
         }
         assert!(touched);
@@ -360,9 +416,9 @@ mod tests {
         let dt = 1e-3;
         for _ in 0..100 {
             b.accelerate(V3::zeros(), V3::new(0.3, 0.02, 0.5), &frame);
-            b.predict(dt);
+            b.predict(0.0, dt);
             b.accelerate(V3::zeros(), V3::new(0.3, 0.02, 0.5), &frame);
-            b.correct(dt);
+            b.correct(0.0, dt);
         }
         // ω = M t / I about y; no turn about x or z in 2D.
         assert!((b.now.omega.y - 0.02 * 0.1 / 0.2).abs() < 1e-12);

@@ -172,10 +172,10 @@ impl BodySpec {
                     self.position[k] + 0.5 * self.size[k],
                 )
             };
-            if a < lo[k] || b > hi[k] {
+            if a < lo[k] + dp || b > hi[k] - dp {
                 return Err(err(
                     f("position"),
-                    format!("the box must start inside the tank (axis {k}: {a:.4}..{b:.4} m, tank {:.4}..{:.4} m)", lo[k], hi[k]),
+                    format!("the box must start at least a particle spacing inside the tank (axis {k}: {a:.4}..{b:.4} m, tank {:.4}..{:.4} m)", lo[k], hi[k]),
                 ));
             }
         }
