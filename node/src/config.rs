@@ -43,6 +43,10 @@ pub const BUILTIN: &[(&str, &str)] = &[
         "flooding_case_c",
         include_str!("../../launch-configs/flooding_case_c.yaml"),
     ),
+    (
+        "flooding_3d_compartment",
+        include_str!("../../launch-configs/flooding_3d_compartment.yaml"),
+    ),
 ];
 
 #[derive(Debug, thiserror::Error)]
@@ -72,7 +76,7 @@ pub enum ConfigError {
 
 const DOF_NAMES: &str = "x, y, z, roll, pitch, yaw";
 
-/// An opening in a floating body's walls (see [`sph::body::OpeningSpec`]).
+/// An opening in a floating body's walls or an internal wall (see [`sph::body::RegionSpec`]).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OpeningCfg {
@@ -116,8 +120,21 @@ pub struct BodyCfg {
     pub fixed: Vec<sph::body::Dof>,
     #[serde(default)]
     pub openings: std::collections::BTreeMap<String, OpeningCfg>,
+    /// Internal walls dividing the hollow, as boxes like the openings.
+    #[serde(default)]
+    pub bulkheads: std::collections::BTreeMap<String, OpeningCfg>,
     #[serde(default)]
     pub springs: std::collections::BTreeMap<String, SpringCfg>,
+}
+
+fn regions(m: &std::collections::BTreeMap<String, OpeningCfg>) -> Vec<sph::body::RegionSpec> {
+    m.iter()
+        .map(|(n, o)| sph::body::RegionSpec {
+            name: n.clone(),
+            centre: o.centre,
+            size: o.size,
+        })
+        .collect()
 }
 
 impl BodyCfg {
@@ -133,15 +150,8 @@ impl BodyCfg {
             velocity: self.velocity,
             angular_velocity: self.angular_velocity,
             fixed: self.fixed.clone(),
-            openings: self
-                .openings
-                .iter()
-                .map(|(n, o)| sph::body::OpeningSpec {
-                    name: n.clone(),
-                    centre: o.centre,
-                    size: o.size,
-                })
-                .collect(),
+            openings: regions(&self.openings),
+            bulkheads: regions(&self.bulkheads),
             springs: self
                 .springs
                 .iter()

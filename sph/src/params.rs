@@ -346,11 +346,34 @@ impl SimParams {
         }
     }
 
+    /// The names of the moving bodies in the order observations list them: the floating bodies, then
+    /// `wave_maker` if there is one.
+    pub fn body_names(&self) -> Vec<String> {
+        self.bodies
+            .iter()
+            .map(|b| b.name.clone())
+            .chain(self.wave_maker.as_ref().map(|_| "wave_maker".to_string()))
+            .collect()
+    }
+
+    /// The wave maker's plate thickness (its own, or the tank walls') and where its face rests (x).
+    pub fn wave_maker_plate(&self) -> Option<(f64, f64)> {
+        let wm = self.wave_maker.as_ref()?;
+        let dp = self.particle_spacing;
+        let thickness = if wm.thickness > 0.0 {
+            wm.thickness
+        } else {
+            self.wall_layers() as f64 * dp
+        };
+        let face = crate::body::piston::rest_face(wm, -0.5 * self.tank.length, thickness, dp);
+        Some((thickness, face))
+    }
+
     /// Floating bodies need the symplectic WCSPH scheme with wall particle layers, each checked against the
     /// tank.
     fn validate_bodies(&self) -> Result<(), ParamError> {
-        if let Some(wm) = &self.wave_maker {
-            wm.validate(self.tank.length, self.particle_spacing)?;
+        if let (Some(wm), Some((thickness, _))) = (&self.wave_maker, self.wave_maker_plate()) {
+            wm.validate(self.tank.length, thickness, self.particle_spacing)?;
         }
         let field = match (self.bodies.first(), &self.wave_maker) {
             (Some(first), _) => format!("bodies.{}", first.name),
@@ -381,19 +404,21 @@ impl SimParams {
             self.tank.height,
         ];
         for (i, b) in self.bodies.iter().enumerate() {
-            if b.name.is_empty()
-                || b.name.contains(',')
-                || self.bodies[..i].iter().any(|o| o.name == b.name)
-            {
-                return Err(err(
-                    "bodies",
-                    format!(
-                        "body names must be non-empty, unique and free of commas, got `{}`",
-                        b.name
-                    ),
-                ));
+            let ok = b.name.starts_with(|c: char| c.is_ascii_alphabetic())
+                && b.name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_');
+            if !ok || b.name == "wave_maker" || self.bodies[..i].iter().any(|o| o.name == b.name) {
+                return Err(err("bodies", format!("body names must be unique, start with a letter and hold only letters, digits and `_` (they become ROS 2 topic names), and `wave_maker` is taken; got `{}`", b.name)));
             }
             b.validate(self.dimension, lo, hi, self.particle_spacing, support)?;
+            if let (Some(wm), Some((_, face))) = (&self.wave_maker, self.wave_maker_plate()) {
+                let start = b.position[0] - 0.5 * b.size[0];
+                let clear = face + 0.5 * wm.stroke + self.particle_spacing;
+                if start < clear {
+                    return Err(err(&format!("bodies.{}.position", b.name), format!("the box starts at x = {start:.4} m, within the wave maker's reach (its plate's face comes forward to {clear:.4} m with a spacing to spare)")));
+                }
+            }
         }
         Ok(())
     }

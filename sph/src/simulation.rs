@@ -139,13 +139,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             );
         }
         // A wave maker's plate at the −x end, the liquid in front of it.
-        if let Some(wm) = &params.wave_maker {
-            let thickness = if wm.thickness > 0.0 {
-                wm.thickness
-            } else {
-                layers as f64 * dp
-            };
-            let face = piston::rest_face(wm, tank.lo[0], thickness, dp);
+        if let (Some(wm), Some((thickness, face))) = (&params.wave_maker, params.wave_maker_plate())
+        {
             let n = ((thickness / dp).round() as usize).max(2);
             let pts = piston::plate_points(face, n, params.tank.height, params.tank.breadth, D, dp);
             points.retain(|x| x[0] > face + 0.499 * dp);
@@ -199,11 +194,6 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         };
         let dom = match comm.filter(|c| c.size() > 1) {
             None => None,
-            Some(_) if !bodies.is_empty() => {
-                return Err(SimError::Decomposition(
-                    "floating bodies run in one process: start it without mpirun".into(),
-                ))
-            }
             Some(c) => {
                 // Mirror ghosts are rebuilt from where particles are mid-step, which may be a column
                 // beyond where they were sorted: one more halo column brings their sources.
@@ -486,7 +476,25 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 &self.bodies.slots,
                 &mut self.bodies.forces,
             );
-            let wrenches = self.bodies.sum_forces();
+            let mut wrenches = self.bodies.sum_forces();
+            if let Some(dom) = &self.dom {
+                // Each rank summed its own liquid's part: the totals, the same on every rank, so every rank
+                // moves the bodies alike.
+                let mut v: Vec<f64> = wrenches
+                    .iter()
+                    .flat_map(|(f, m)| f.iter().chain(m.iter()).copied().collect::<Vec<_>>())
+                    .chain(self.bodies.total_force)
+                    .chain(self.bodies.total_moment)
+                    .collect();
+                dom.comm.reduce(&mut v, Op::Sum);
+                for (i, w) in wrenches.iter_mut().enumerate() {
+                    w.0 = nalgebra::Vector3::from_fn(|k, _| v[6 * i + k]);
+                    w.1 = nalgebra::Vector3::from_fn(|k, _| v[6 * i + 3 + k]);
+                }
+                let n = 6 * wrenches.len();
+                self.bodies.total_force.copy_from_slice(&v[n..n + 3]);
+                self.bodies.total_moment.copy_from_slice(&v[n + 3..n + 6]);
+            }
             for (body, (f, m)) in self.bodies.list.iter_mut().zip(wrenches) {
                 body.accelerate(f, m, &frame);
             }
@@ -503,6 +511,20 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     /// Moves the bodies' particles to where the bodies are and sorts the boundary particles again.
     fn place_bodies(&mut self, t: f64) -> Result<(), SimError> {
+        let finite = |b: &RigidBody| {
+            let p = &b.now;
+            p.cog
+                .iter()
+                .chain(p.vel.iter())
+                .chain(p.omega.iter())
+                .all(|v| v.is_finite())
+        };
+        if !self.bodies.list.iter().all(finite) {
+            return Err(SimError::NonFinite {
+                time: t,
+                step: self.stats.steps,
+            });
+        }
         self.bodies.place(&mut self.bound);
         let before = self.bound.len();
         self.bound.sort(&self.grid, &mut self.scratch);
@@ -807,22 +829,27 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         })
     }
 
-    /// The liquid in each body's hollow, m³ (2D: m² = m³ per metre of breadth).
+    /// The liquid in each body's hollow, m³ (2D: m² = m³ per metre of breadth; across ranks: summed).
     fn flooded_volumes(&self) -> Vec<f64> {
         let cell = self.coef.m_fluid as f64 / self.coef.rho0 as f64;
-        self.bodies
+        let mut v: Vec<f64> = self
+            .bodies
             .list
             .iter()
             .map(|b| {
                 let n = (0..self.fluid.len())
                     .filter(|&i| {
                         let x = to3(self.fluid.position(i));
-                        b.inside(nalgebra::Vector3::from(x), D)
+                        self.fluid.owned(i) && b.inside(nalgebra::Vector3::from(x), D)
                     })
                     .count();
-                n as f64 * cell
+                n as f64
             })
-            .collect()
+            .collect();
+        if let Some(dom) = &self.dom {
+            dom.comm.reduce(&mut v, Op::Sum);
+        }
+        v.iter().map(|n| n * cell).collect()
     }
 
     /// Each body's motion, the liquid's force on it and the liquid inside it now (2D: per metre of breadth).
@@ -981,10 +1008,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             return self.gather_snapshot(dom, s);
         }
         for j in 0..nb {
-            s.position
-                .push(to3(std::array::from_fn::<f32, D, _>(|k| b.x[k][j])));
-            s.velocity
-                .push(to3(std::array::from_fn::<f32, D, _>(|k| b.v[k][j])));
+            let (x, v) = self.wall_particle(j);
+            s.position.push(x);
+            s.velocity.push(v);
             let rho = b.rho.get(j).map_or(self.eos.rho0, |&r| r as f32);
             s.pressure
                 .push(if dfsph { 0.0 } else { self.eos.pressure(rho) });
@@ -993,6 +1019,28 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             s.id.push(j as u32);
         }
         s
+    }
+
+    /// Position and velocity of boundary particle j now (x, y, z): a floating body's where the body is
+    /// (its particles were last placed at the half step), a wall's where it stands.
+    fn wall_particle(&self, j: usize) -> ([f32; 3], [f32; 3]) {
+        let b = &self.bound;
+        match b
+            .tag
+            .get(j)
+            .copied()
+            .filter(|&t| t != crate::particles::NOT_BODY)
+        {
+            Some(t) => {
+                let (body, i) = self.bodies.which[t as usize];
+                let (x, v) = self.bodies.list[body as usize].particle(i as usize);
+                (x.map(|c| c as f32).into(), v.map(|c| c as f32).into())
+            }
+            None => (
+                to3(std::array::from_fn::<f32, D, _>(|k| b.x[k][j])),
+                to3(std::array::from_fn::<f32, D, _>(|k| b.v[k][j])),
+            ),
+        }
     }
 
     /// Rank 0: the liquid of every rank (in the order of the ids) and the walls with their owners'
@@ -1046,10 +1094,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             density: fluid.iter().map(|r| r[8] as f32).collect(),
         };
         for j in 0..b.len() {
-            s.position
-                .push(to3(std::array::from_fn::<f32, D, _>(|k| b.x[k][j])));
-            s.velocity
-                .push(to3(std::array::from_fn::<f32, D, _>(|k| b.v[k][j])));
+            let (x, v) = self.wall_particle(j);
+            s.position.push(x);
+            s.velocity.push(v);
             let rho = wall_rho.get(j).map_or(self.eos.rho0, |&r| r as f32);
             s.pressure
                 .push(if dfsph { 0.0 } else { self.eos.pressure(rho) });

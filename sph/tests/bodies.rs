@@ -2,7 +2,7 @@
 //! its heave and roll periods in free decay fall where the restoring stiffness and plausible added masses
 //! put them, and water pours into a fixed damaged box at the rate of the orifice law. 2D, dp = 5 mm.
 
-use sph::body::{BodySpec, BodyState, Dof, OpeningSpec};
+use sph::body::{BodySpec, BodyState, Dof, RegionSpec};
 use sph::motion::AtRest;
 use sph::params::*;
 use sph::Solver;
@@ -56,6 +56,7 @@ fn floating_box(draught: f64, kg: f64, inertia: f64) -> BodySpec {
         angular_velocity: [0.0; 3],
         fixed: vec![],
         openings: vec![],
+        bulkheads: vec![],
         springs: vec![],
     }
 }
@@ -176,7 +177,7 @@ fn water_pours_into_a_damaged_box_by_the_orifice_law() {
     let width = 0.02;
     let mut spec = floating_box(draught, 0.05, 0.147);
     spec.fixed = Dof::ALL.to_vec();
-    spec.openings.push(OpeningSpec {
+    spec.openings.push(RegionSpec {
         name: "bottom".into(),
         centre: [0.0, 0.0, 0.5 * WALL],
         size: [width, 1.0, 2.0 * WALL],
@@ -300,6 +301,7 @@ fn a_3d_box_floats_level_at_its_draught() {
         angular_velocity: [0.0; 3],
         fixed: vec![],
         openings: vec![],
+        bulkheads: vec![],
         springs: vec![],
     }]);
     p.dimension = 3;

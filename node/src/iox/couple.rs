@@ -57,6 +57,20 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
             opts.particles_hz
         );
     }
+    if let Some(b) = params.bodies.first() {
+        anyhow::bail!(
+            "{}: bodies.{}: floating bodies are not served over iceoryx2 yet (their motion has no place in \
+             the step reply); run the case with `slosh run` or `slosh node`",
+            cfg.source_name,
+            b.name
+        );
+    }
+    if params.wave_maker.is_some() {
+        anyhow::bail!(
+            "{}: wave_maker: not served over iceoryx2 yet; run the case with `slosh run` or `slosh node`",
+            cfg.source_name
+        );
+    }
     let tp = cfg.config.frames.tank_pose;
     let mount = Mount {
         offset: Vector3::new(tp.x, tp.y, tp.z),

@@ -433,10 +433,10 @@ pub fn run(
     // Each floating body's motion and the liquid's force on it.
     let mut pub_bodies: Vec<(Publisher<Odometry>, Publisher<WrenchStamped>)> = Vec::new();
     if iox.dds_outputs {
-        for b in &params.bodies {
+        for name in params.body_names() {
             pub_bodies.push((
-                super::publisher(&mut node, &names, &body_topic(&b.name, "odom"), &out_qos)?,
-                super::publisher(&mut node, &names, &body_topic(&b.name, "wrench"), &out_qos)?,
+                super::publisher(&mut node, &names, &body_topic(&name, "odom"), &out_qos)?,
+                super::publisher(&mut node, &names, &body_topic(&name, "wrench"), &out_qos)?,
             ));
         }
     }

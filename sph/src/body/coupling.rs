@@ -4,12 +4,13 @@
 
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, NO_RANGES};
-use crate::particles::{Boundary, Fluid};
+use crate::particles::{Boundary, Fluid, HALO};
 use crate::scheme::wcsph::Coefficients;
 use crate::tank::to3;
 use rayon::prelude::*;
 
 /// Force of the liquid on the boundary particles at `slots` (x, y, z; per unit breadth in 2D), into `out`.
+/// Halo copies (MPI) are left out: each rank adds its own liquid's part.
 pub fn liquid_forces<const D: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
@@ -31,6 +32,9 @@ pub fn liquid_forces<const D: usize, K: Kernel>(
             let mut force = [0.0f64; D];
             for &(lo, hi) in &ranges[..n] {
                 for j in lo as usize..hi as usize {
+                    if fluid.id[j] & HALO != 0 {
+                        continue;
+                    }
                     let mut dx = [0.0f32; D];
                     let mut vd = [0.0f32; D];
                     let (mut r2, mut vr) = (0.0f32, 0.0f32);

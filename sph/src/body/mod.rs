@@ -11,7 +11,7 @@ pub mod spec;
 
 pub use piston::PistonSpec;
 pub use rigid::RigidBody;
-pub use spec::{BodySpec, Dof, OpeningSpec, SpringSpec};
+pub use spec::{BodySpec, Dof, RegionSpec, SpringSpec};
 
 use crate::particles::{Boundary, NOT_BODY};
 use nalgebra::Vector3;
@@ -22,8 +22,8 @@ pub struct BodyState {
     pub name: String,
     /// Centre of gravity, m.
     pub position: [f64; 3],
-    /// Orientation as a quaternion (x, y, z, w) and as roll, pitch, yaw (rad, x-y'-z'' intrinsic … as
-    /// nalgebra's `euler_angles`: rotation = Rz(yaw) Ry(pitch) Rx(roll)).
+    /// Orientation as a quaternion (x, y, z, w) and as roll, pitch, yaw (rad; rotation =
+    /// Rz(yaw)·Ry(pitch)·Rx(roll), intrinsic z-y'-x'').
     pub quaternion: [f64; 4],
     pub roll_pitch_yaw: [f64; 3],
     /// m/s and rad/s.

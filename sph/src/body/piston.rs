@@ -22,7 +22,8 @@ pub struct PistonSpec {
 }
 
 impl PistonSpec {
-    pub fn validate(&self, tank_length: f64, dp: f64) -> Result<(), ParamError> {
+    /// Checks the settings against the tank's length, the plate's actual thickness and the spacing.
+    pub fn validate(&self, tank_length: f64, thickness: f64, dp: f64) -> Result<(), ParamError> {
         let bad = |field: &str, message: String| ParamError {
             field: format!("wave_maker.{field}"),
             message,
@@ -54,7 +55,7 @@ impl PistonSpec {
         if self.thickness > 0.0 && self.thickness < 2.0 * dp {
             return Err(bad("thickness", format!("{} m is thinner than two particle spacings: the liquid would leak through (0: as thick as the tank's walls)", self.thickness)));
         }
-        if self.stroke + self.thickness + 4.0 * dp > 0.5 * tank_length {
+        if self.stroke + thickness + 4.0 * dp > 0.5 * tank_length {
             return Err(bad(
                 "stroke",
                 format!(

@@ -283,11 +283,12 @@ impl RigidBody {
 
 impl RigidBody {
     /// Keeps the body's particles at least `gap` inside the tank's box (`lo`, `hi`, tank frame) along the
-    /// `axes`: a body that reaches a wall is moved back onto it and loses its velocity into the wall (an
-    /// inelastic contact, without friction or the contact's moment). Returns whether it touched.
+    /// `axes` (those it may move along): a body that reaches a wall is moved back onto it and loses its
+    /// velocity into the wall (an inelastic contact, without friction or the contact's moment). Returns
+    /// whether it touched.
     pub fn contain(&mut self, lo: V3, hi: V3, gap: f64, axes: &[usize]) -> bool {
         let mut touched = false;
-        for &k in axes {
+        for &k in axes.iter().filter(|&&k| self.free[k]) {
             let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
             for i in 0..self.local.len() {
                 let x = self.now.cog[k] + (self.now.rot * self.local[i])[k];
@@ -325,6 +326,7 @@ mod tests {
             angular_velocity: [0.0; 3],
             fixed: vec![],
             openings: vec![],
+            bulkheads: vec![],
             springs: vec![],
         }
     }

@@ -1,5 +1,5 @@
 //! The particles of a hollow box: every lattice point of the box within `wall_thickness` of its outer
-//! faces, less those in an opening.
+//! faces or in a bulkhead, less those in an opening.
 
 use super::spec::BodySpec;
 
@@ -35,7 +35,7 @@ pub fn wall_points(spec: &BodySpec, dimension: usize, dp: f64) -> Vec<[f64; 3]> 
             };
             inner &= from_low > t && from_low < spec.size[k] - t;
         }
-        if !inner && !spec.in_opening(p, dimension) {
+        if (!inner || spec.in_bulkhead(p, dimension)) && !spec.in_opening(p, dimension) {
             out.push(p);
         }
     }
@@ -57,7 +57,7 @@ pub fn covers(spec: &BodySpec, dimension: usize, p: [f64; 3], margin: f64) -> bo
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body::spec::OpeningSpec;
+    use crate::body::spec::RegionSpec;
 
     fn spec() -> BodySpec {
         BodySpec {
@@ -72,6 +72,7 @@ mod tests {
             angular_velocity: [0.0; 3],
             fixed: vec![],
             openings: vec![],
+            bulkheads: vec![],
             springs: vec![],
         }
     }
@@ -83,7 +84,7 @@ mod tests {
         let p = wall_points(&s, 2, 0.0025);
         assert_eq!(p.len(), 40 * 40 - 32 * 32);
         let mut o = s.clone();
-        o.openings.push(OpeningSpec {
+        o.openings.push(RegionSpec {
             name: "hole".into(),
             centre: [0.05, 0.0, 0.05],
             size: [0.02, 1.0, 0.02],
@@ -94,6 +95,14 @@ mod tests {
         assert!(q
             .iter()
             .all(|x| !(x[0] > 0.04 && (x[2] - 0.05).abs() < 0.01)));
+        // A bulkhead 10 mm thick across the middle of the hollow (32 rows of 4), with the opening's rows cut.
+        let mut c = o.clone();
+        c.bulkheads.push(RegionSpec {
+            name: "middle".into(),
+            centre: [0.0, 0.0, 0.05],
+            size: [0.01, 1.0, 0.1],
+        });
+        assert_eq!(wall_points(&c, 2, 0.0025).len(), q.len() + 32 * 4);
         // 3D: 40³ − 32³.
         assert_eq!(
             wall_points(&s, 3, 0.0025).len(),

@@ -8,14 +8,16 @@
 use crate::params::ParamError;
 use serde::{Deserialize, Serialize};
 
-/// A region of the box's walls left out (a hole): a box in box coordinates.
+/// A box in box coordinates: an opening (damage) cut from the walls, or an internal wall (a bulkhead or deck
+/// that divides the hollow into compartments).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct OpeningSpec {
+pub struct RegionSpec {
     pub name: String,
     /// Centre, box coordinates, m.
     pub centre: [f64; 3],
-    /// Extent along x, y, z, m (make it at least the wall thickness across the wall it cuts).
+    /// Extent along x, y, z, m (an opening at least the wall thickness across the wall it cuts, a bulkhead at
+    /// least the kernel support thick).
     pub size: [f64; 3],
 }
 
@@ -84,7 +86,10 @@ pub struct BodySpec {
     #[serde(default)]
     pub fixed: Vec<Dof>,
     #[serde(default)]
-    pub openings: Vec<OpeningSpec>,
+    pub openings: Vec<RegionSpec>,
+    /// Internal walls (openings cut them too).
+    #[serde(default)]
+    pub bulkheads: Vec<RegionSpec>,
     #[serde(default)]
     pub springs: Vec<SpringSpec>,
 }
@@ -179,14 +184,16 @@ impl BodySpec {
                 ));
             }
         }
-        for o in &self.openings {
-            finite3(f(&format!("openings.{}.centre", o.name)), &o.centre)?;
-            finite3(f(&format!("openings.{}.size", o.name)), &o.size)?;
-            if axes.iter().any(|&k| !(o.size[k] > 0.0)) {
-                return Err(err(
-                    f(&format!("openings.{}.size", o.name)),
-                    "every extent must be positive",
-                ));
+        for (group, regions) in [("openings", &self.openings), ("bulkheads", &self.bulkheads)] {
+            for o in regions {
+                finite3(f(&format!("{group}.{}.centre", o.name)), &o.centre)?;
+                finite3(f(&format!("{group}.{}.size", o.name)), &o.size)?;
+                if axes.iter().any(|&k| !(o.size[k] > 0.0)) {
+                    return Err(err(
+                        f(&format!("{group}.{}.size", o.name)),
+                        "every extent must be positive",
+                    ));
+                }
             }
         }
         for s in &self.springs {
@@ -210,10 +217,20 @@ impl BodySpec {
 
     /// Whether a point in box coordinates lies in one of the openings.
     pub fn in_opening(&self, p: [f64; 3], dimension: usize) -> bool {
-        self.openings.iter().any(|o| {
-            (0..3)
-                .filter(|&k| dimension == 3 || k != 1)
-                .all(|k| (p[k] - o.centre[k]).abs() <= 0.5 * o.size[k])
-        })
+        self.openings.iter().any(|o| o.contains(p, dimension))
+    }
+
+    /// Whether a point in box coordinates lies in one of the bulkheads.
+    pub fn in_bulkhead(&self, p: [f64; 3], dimension: usize) -> bool {
+        self.bulkheads.iter().any(|o| o.contains(p, dimension))
+    }
+}
+
+impl RegionSpec {
+    /// Whether a point in box coordinates lies in the region (2D: ignoring y).
+    pub fn contains(&self, p: [f64; 3], dimension: usize) -> bool {
+        (0..3)
+            .filter(|&k| dimension == 3 || k != 1)
+            .all(|k| (p[k] - self.centre[k]).abs() <= 0.5 * self.size[k])
     }
 }
