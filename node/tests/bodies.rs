@@ -1,5 +1,5 @@
 //! Floating bodies through the command line: the paper's flooding cases reject a resolution their walls
-//! cannot hold, a coarse damaged box floods and writes `bodies.csv`, and its recording carries each body's
+//! cannot hold (or an integrator that cannot move them), a coarse damaged box floods and writes `bodies.csv`, and its recording carries each body's
 //! Odometry and wrench, read by rosbags and mcap with the CSV's values.
 
 mod common;
@@ -58,17 +58,17 @@ fn walls_thinner_than_the_kernel_are_refused_by_name() {
         err.contains("bodies.box.wall_thickness") && err.contains("kernel support"),
         "{err}"
     );
-    // The incompressible scheme does not move bodies yet: said so, by name.
+    // The weakly-compressible scheme moves bodies with its symplectic steps only: said so, by name.
     let out = slosh()
         .args(["run", "flooding_case_a", "--duration", "0.01", "--out"])
-        .arg(common::tmp("bodies_dfsph").join("out"))
-        .args(["--set", "solver.scheme=dfsph"])
+        .arg(common::tmp("bodies_verlet").join("out"))
+        .args(["--set", "solver.integrator=verlet"])
         .output()
         .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("bodies.box") && err.contains("solver.scheme: wcsph"),
+        err.contains("bodies.box") && err.contains("solver.integrator: symplectic"),
         "{err}"
     );
 }

@@ -381,14 +381,8 @@ impl SimParams {
             (None, None) => return Ok(()),
         };
         let s = &self.solver;
-        if s.scheme != Scheme::Wcsph {
-            return Err(err(
-                &field,
-                "floating bodies and wave makers run with solver.scheme: wcsph (dfsph does not move them yet)",
-            ));
-        }
-        if s.integrator != Integrator::Symplectic {
-            return Err(err(&field, "floating bodies and wave makers move with the liquid's symplectic steps: set solver.integrator: symplectic"));
+        if s.scheme == Scheme::Wcsph && s.integrator != Integrator::Symplectic {
+            return Err(err(&field, "floating bodies and wave makers move with the liquid's symplectic steps: set solver.integrator: symplectic (or solver.scheme: dfsph)"));
         }
         if s.boundary.method != BoundaryMethod::Dynamic {
             return Err(err(

@@ -190,7 +190,18 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         shell.points.sort(&grid, &mut scratch);
         let rho_rest = {
             let m_bound = (rho0 * wall_volume) as f32;
-            rest_density(&kernel, &fluid, &bound, m_fluid as f32, m_bound) as f32
+            // Not a particle by a body or the wave maker's plate, whose neighbourhood may be cut short (a
+            // hole, a corner) where the middle of the liquid falls.
+            let near_body = |x: [f64; D]| {
+                let x = to3(x);
+                params.bodies.iter().any(|b| {
+                    let p = std::array::from_fn(|k| x[k] - b.position[k]);
+                    shell::covers(b, D, p, support)
+                }) || params.wave_maker_plate().is_some_and(|(_, face)| {
+                    x[0] < face + support + params.wave_maker.as_ref().map_or(0.0, |w| w.stroke)
+                })
+            };
+            rest_density(&kernel, &fluid, &bound, m_fluid as f32, m_bound, near_body) as f32
         };
         let dom = match comm.filter(|c| c.size() > 1) {
             None => None,
@@ -277,6 +288,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         };
         if !sim.bodies.is_empty() {
             sim.bodies.last_flooded = Some((0.0, sim.flooded_volumes()));
+            // Bodies start from rest with forces the liquid has not balanced yet (a hole, a kick): the
+            // incompressible scheme's steps start a tenth of their longest and grow as the solves allow.
+            sim.dwork.start_at(0.1 * sim.params.solver.dfsph.dt_max);
         }
         Ok(sim)
     }
@@ -292,7 +306,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 end,
             });
         }
-        let r = self.solve_dfsph(motion, room, false)?;
+        let frame_at_start = self.frame(motion, t);
+        let r = self.solve_dfsph(motion, room.min(self.body_step_limit()), false)?;
         let spec = &self.params.solver.dfsph;
         let st = &mut self.stats;
         let its = r.density_iterations + r.divergence_iterations;
@@ -316,12 +331,18 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 dt_min: self.dt_min,
             });
         }
+        if !self.bodies.is_empty() {
+            self.move_bodies_dfsph(&frame_at_start, t, r.dt);
+        }
+        // The tank's walls alone: less the bodies' share of the boundary's force.
+        let b = &self.bodies;
         for k in 0..3 {
-            self.impulse.force[k] += r.totals.force[k] * r.dt;
-            self.impulse.moment[k] += r.totals.moment[k] * r.dt;
+            self.impulse.force[k] += (r.totals.force[k] + b.total_force[k]) * r.dt;
+            self.impulse.moment[k] += (r.totals.moment[k] + b.total_moment[k]) * r.dt;
         }
         self.impulse_time += r.dt;
         self.time = t + r.dt;
+        let st = &mut self.stats;
         st.steps += 1;
         st.last_dt = r.dt;
         st.min_dt = st.min_dt.min(r.dt);
@@ -340,6 +361,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let frame = self.frame(motion, t);
         self.rebin(t, false)?;
         self.fluid.refresh(|_, p| p as f32);
+        if !self.bodies.is_empty() {
+            self.place_bodies(t)?;
+        }
         let r = dfsph::step(
             &self.kernel,
             &self.dcoef,
@@ -476,28 +500,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 &self.bodies.slots,
                 &mut self.bodies.forces,
             );
-            let mut wrenches = self.bodies.sum_forces();
-            if let Some(dom) = &self.dom {
-                // Each rank summed its own liquid's part: the totals, the same on every rank, so every rank
-                // moves the bodies alike.
-                let mut v: Vec<f64> = wrenches
-                    .iter()
-                    .flat_map(|(f, m)| f.iter().chain(m.iter()).copied().collect::<Vec<_>>())
-                    .chain(self.bodies.total_force)
-                    .chain(self.bodies.total_moment)
-                    .collect();
-                dom.comm.reduce(&mut v, Op::Sum);
-                for (i, w) in wrenches.iter_mut().enumerate() {
-                    w.0 = nalgebra::Vector3::from_fn(|k, _| v[6 * i + k]);
-                    w.1 = nalgebra::Vector3::from_fn(|k, _| v[6 * i + 3 + k]);
-                }
-                let n = 6 * wrenches.len();
-                self.bodies.total_force.copy_from_slice(&v[n..n + 3]);
-                self.bodies.total_moment.copy_from_slice(&v[n + 3..n + 6]);
-            }
-            for (body, (f, m)) in self.bodies.list.iter_mut().zip(wrenches) {
-                body.accelerate(f, m, &frame);
-            }
+            self.accelerate_bodies(&frame, false);
         }
         self.stats.force_evaluations += 1;
         if self.last.non_finite {
@@ -507,6 +510,85 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             });
         }
         Ok(())
+    }
+
+    /// The longest divergence-free step the bodies allow: their fastest particle moves at most `cfl` of a
+    /// spacing, also under their accelerations (the liquid's own limit knows nothing of them).
+    fn body_step_limit(&self) -> f64 {
+        let cfl = self.params.solver.dfsph.cfl;
+        let dp = self.params.particle_spacing;
+        let mut dt = f64::INFINITY;
+        for b in &self.bodies.list {
+            let reach = b.local.iter().fold(0.0f64, |m, r| m.max(r.norm()));
+            let v = b.now.vel.norm() + b.now.omega.norm() * reach;
+            let a = b.acc.norm() + b.alpha.norm() * reach;
+            if v > 0.0 {
+                dt = dt.min(cfl * dp / v);
+            }
+            if a > 0.0 {
+                dt = dt.min(cfl * (dp / a).sqrt());
+            }
+        }
+        dt
+    }
+
+    /// After a divergence-free step of `dt` from t: the liquid's force on the bodies over the step (from the
+    /// positions it was solved at and each particle's total k), and the bodies moved with it.
+    fn move_bodies_dfsph(&mut self, frame: &FrameTerms, t: f64, dt: f64) {
+        let f = &self.fluid;
+        coupling::liquid_forces_dfsph(
+            &self.kernel,
+            &self.dcoef,
+            &self.grid,
+            f,
+            &self.bound,
+            |a| (f.kappa[a] + f.kappa_div[a]) as f32,
+            &self.bodies.slots,
+            &mut self.bodies.forces,
+        );
+        self.accelerate_bodies(frame, true);
+        let (lo, hi) = (to3(self.tank.lo), to3(self.tank.hi));
+        let axes: &[usize] = if D == 2 { &[0, 2] } else { &[0, 1, 2] };
+        for b in self.bodies.list.iter_mut() {
+            b.advance(t, dt);
+            if !b.is_driven() {
+                b.contain(lo.into(), hi.into(), self.params.particle_spacing, axes);
+            }
+        }
+    }
+
+    /// Sums the per-particle forces of the last evaluation into each body's force and moment (over all
+    /// ranks) and sets the bodies' accelerations (`relaxed`: with the artificial added mass of a
+    /// partitioned step, [`RigidBody::accelerate_relaxed`]).
+    fn accelerate_bodies(&mut self, frame: &FrameTerms, relaxed: bool) {
+        let mut wrenches = self.bodies.sum_forces();
+        if let Some(dom) = &self.dom {
+            // Each rank summed its own liquid's part: the totals, the same on every rank, so every rank
+            // moves the bodies alike.
+            let mut v: Vec<f64> = wrenches
+                .iter()
+                .flat_map(|(f, m)| f.iter().chain(m.iter()).copied().collect::<Vec<_>>())
+                .chain(self.bodies.total_force)
+                .chain(self.bodies.total_moment)
+                .collect();
+            dom.comm.reduce(&mut v, Op::Sum);
+            for (i, w) in wrenches.iter_mut().enumerate() {
+                w.0 = nalgebra::Vector3::from_fn(|k, _| v[6 * i + k]);
+                w.1 = nalgebra::Vector3::from_fn(|k, _| v[6 * i + 3 + k]);
+            }
+            let n = 6 * wrenches.len();
+            self.bodies.total_force.copy_from_slice(&v[n..n + 3]);
+            self.bodies.total_moment.copy_from_slice(&v[n + 3..n + 6]);
+        }
+        let rho = self.params.fluid.density;
+        for (body, (f, m)) in self.bodies.list.iter_mut().zip(wrenches) {
+            if relaxed {
+                let (ma, ia) = body.liquid_of_box(rho, D);
+                body.accelerate_relaxed(f, m, frame, ma, ia);
+            } else {
+                body.accelerate(f, m, frame);
+            }
+        }
     }
 
     /// Moves the bodies' particles to where the bodies are and sorts the boundary particles again.
@@ -1121,13 +1203,14 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 }
 
 /// The density a liquid particle inside the initial lattice sums to (the incompressible scheme holds it):
-/// that of the particle nearest the middle of the liquid block.
+/// that of the particle nearest the middle of the liquid block, of those not `excluded`.
 fn rest_density<const D: usize, K: Kernel>(
     k: &K,
     fluid: &Fluid<D>,
     bound: &Boundary<D>,
     m_fluid: f32,
     m_bound: f32,
+    excluded: impl Fn([f64; D]) -> bool,
 ) -> f64 {
     let n = fluid.len();
     let centre: [f64; D] =
@@ -1137,7 +1220,10 @@ fn rest_density<const D: usize, K: Kernel>(
             .map(|d| (fluid.pos[d][i] - centre[d]).powi(2))
             .sum::<f64>()
     };
-    let Some(a) = (0..n).min_by(|&i, &j| dist2(i).total_cmp(&dist2(j))) else {
+    let Some(a) = (0..n)
+        .filter(|&i| !excluded(fluid.position(i)))
+        .min_by(|&i, &j| dist2(i).total_cmp(&dist2(j)))
+    else {
         return 0.0;
     };
     let xa = fluid.position(a);

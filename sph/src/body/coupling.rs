@@ -70,3 +70,60 @@ pub fn liquid_forces<const D: usize, K: Kernel>(
         })
         .collect_into_vec(out);
 }
+
+/// Force of the liquid on the boundary particles at `slots` over a divergence-free step (see
+/// [`crate::scheme::dfsph`]): the reaction of the walls' push-back with each liquid particle's total k
+/// (`k(a)`, the step's density and divergence solves), `MIRROR · m_b k_a ∇W_ab`, and of the artificial
+/// viscosity's wall term, from the positions and velocities the step was solved at.
+#[allow(clippy::too_many_arguments)]
+pub fn liquid_forces_dfsph<const D: usize, K: Kernel>(
+    k: &K,
+    c: &crate::scheme::dfsph::Coefficients,
+    grid: &Grid<D>,
+    fluid: &Fluid<D>,
+    bound: &Boundary<D>,
+    kappa: impl Fn(usize) -> f32 + Sync,
+    slots: &[u32],
+    out: &mut Vec<[f64; 3]>,
+) {
+    let p = &c.pair;
+    slots
+        .par_iter()
+        .map(|&b| {
+            let b = b as usize;
+            let xb: [f32; D] = std::array::from_fn(|d| bound.x[d][b]);
+            let vb: [f32; D] = std::array::from_fn(|d| bound.v[d][b]);
+            let mut ranges = NO_RANGES;
+            let n = grid.ranges(bound.cell[b], &fluid.starts, &mut ranges);
+            let mut force = [0.0f64; D];
+            for &(lo, hi) in &ranges[..n] {
+                for j in lo as usize..hi as usize {
+                    if fluid.id[j] & HALO != 0 {
+                        continue;
+                    }
+                    let mut dx = [0.0f32; D];
+                    let (mut r2, mut vr) = (0.0f32, 0.0f32);
+                    for d in 0..D {
+                        dx[d] = fluid.x[d][j] - xb[d];
+                        r2 += dx[d] * dx[d];
+                        vr += (fluid.v[d][j] - vb[d]) * dx[d];
+                    }
+                    if r2 >= p.support2 {
+                        continue;
+                    }
+                    let gf = k.grad_factor(r2.sqrt());
+                    let mu = p.h * vr.min(0.0) / (r2 + p.eta2);
+                    let pi = -p.alpha_bound * p.c0 * mu / c.rho_rest;
+                    let ka = kappa(j);
+                    for d in 0..D {
+                        // Liquid particle j's acceleration from the body particle, and its reaction.
+                        let acc = -crate::scheme::dfsph::MIRROR * ka * p.m_bound * gf * dx[d]
+                            - p.m_bound * pi * gf * dx[d];
+                        force[d] -= (p.m_fluid * acc) as f64;
+                    }
+                }
+            }
+            to3(force)
+        })
+        .collect_into_vec(out);
+}

@@ -48,6 +48,8 @@ pub struct RigidBody {
     pub cog_box: V3,
     /// The hollow inside in box coordinates: lower and upper corners.
     pub inner: (V3, V3),
+    /// Outer size of its box (x, y, z), m (0 for a wave maker's plate).
+    pub size: V3,
     /// Its particles relative to the centre of gravity, body axes.
     pub local: Vec<V3>,
     pub now: Pose,
@@ -76,7 +78,7 @@ impl RigidBody {
             free[d.index()] = false;
         }
         if dimension == 2 {
-            for d in [Dof::Y, Dof::Rx, Dof::Rz] {
+            for d in [Dof::Sway, Dof::Roll, Dof::Yaw] {
                 free[d.index()] = false;
             }
         }
@@ -113,6 +115,7 @@ impl RigidBody {
                 .collect(),
             cog_box,
             inner,
+            size: v3(spec.size),
             local: points.iter().map(|p| v3(*p) - cog_box).collect(),
             now: pose,
             start: pose,
@@ -143,6 +146,7 @@ impl RigidBody {
             cog_box: V3::zeros(),
             // No hollow: nothing floods it.
             inner: (V3::repeat(1.0), V3::repeat(-1.0)),
+            size: V3::zeros(),
             local: points.iter().map(|p| v3(*p) - centre).collect(),
             now: pose,
             start: pose,
@@ -157,6 +161,19 @@ impl RigidBody {
     /// Whether the body follows a prescribed motion (a wave maker) instead of forces.
     pub fn is_driven(&self) -> bool {
         self.drive.is_some()
+    }
+
+    /// The artificial added mass of [`Self::accelerate_relaxed`]: the liquid that fills the box's outer
+    /// volume (density `rho`; 2D: per metre), and its moments of inertia about the centre of the box.
+    pub fn liquid_of_box(&self, rho: f64, dimension: usize) -> (f64, V3) {
+        let s = self.size;
+        let ma = rho * s.x * s.z * if dimension == 3 { s.y } else { 1.0 };
+        let ia = V3::new(
+            ma * (s.y * s.y + s.z * s.z) / 12.0,
+            ma * (s.x * s.x + s.z * s.z) / 12.0,
+            ma * (s.x * s.x + s.y * s.y) / 12.0,
+        );
+        (ma, ia)
     }
 
     /// A driven body's pose at time t.
@@ -250,6 +267,31 @@ impl RigidBody {
         self.alpha = alpha;
     }
 
+    /// [`Self::accelerate`] for a partitioned coupling (the divergence-free scheme's step computes the
+    /// liquid's force with the body's velocity held): with an artificial added mass `ma` (and moments of
+    /// inertia `ia`, tank axes), (m + ma)·a = m·a_new + ma·a_last, so a body lighter than the liquid it
+    /// drags along does not overshoot step after step (the added-mass instability); in a steady motion
+    /// a_new = a_last and nothing changes.
+    pub fn accelerate_relaxed(
+        &mut self,
+        force: V3,
+        moment: V3,
+        frame: &FrameTerms,
+        ma: f64,
+        ia: V3,
+    ) {
+        let (acc0, alpha0) = (self.acc, self.alpha);
+        self.accelerate(force, moment, frame);
+        let w = self.mass / (self.mass + ma);
+        self.acc = w * self.acc + (1.0 - w) * acc0;
+        let inertia = self.now.rot.matrix() * self.inertia * self.now.rot.matrix().transpose();
+        for k in 0..3 {
+            let i = inertia[(k, k)];
+            let w = i / (i + ia[k]);
+            self.alpha[k] = w * self.alpha[k] + (1.0 - w) * alpha0[k];
+        }
+    }
+
     /// Saves the state (at time t) and advances it half a step with the accelerations of the state.
     pub fn predict(&mut self, t: f64, dt: f64) {
         self.start = self.now;
@@ -262,6 +304,20 @@ impl RigidBody {
         p.rot = Rotation3::new(h * p.omega) * p.rot;
         p.vel += h * self.acc;
         p.omega += h * self.alpha;
+    }
+
+    /// One step of the divergence-free scheme (from t): symplectic Euler with the accelerations of the
+    /// step's solve, as the liquid is moved (its new velocity, then the position from it).
+    pub fn advance(&mut self, t: f64, dt: f64) {
+        self.start = self.now;
+        if self.drive_to(t + dt) {
+            return;
+        }
+        let p = &mut self.now;
+        p.vel += dt * self.acc;
+        p.omega += dt * self.alpha;
+        p.cog += dt * p.vel;
+        p.rot = Rotation3::new(dt * p.omega) * p.rot;
     }
 
     /// Completes the step (from t) from the accelerations at the half step.

@@ -37,22 +37,35 @@ pub struct SpringSpec {
     pub rest_length: f64,
 }
 
-/// A degree of freedom of a body, in the tank's axes.
+/// A degree of freedom of a body, along or about the tank's axes: `surge` (x), `sway` (y), `heave` (z),
+/// `roll` (about x), `pitch` (about y), `yaw` (about z). The axis names `x`, `z`, `rx`, `ry`, `rz` work too
+/// (YAML reads a bare `y` as a boolean: write `sway`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Dof {
-    /// Translations along x, y, z.
-    X,
-    Y,
-    Z,
-    /// Rotations about x, y, z (a 2D run turns about y only).
-    Rx,
-    Ry,
-    Rz,
+    #[serde(alias = "x")]
+    Surge,
+    #[serde(alias = "y")]
+    Sway,
+    #[serde(alias = "z")]
+    Heave,
+    #[serde(alias = "rx")]
+    Roll,
+    #[serde(alias = "ry")]
+    Pitch,
+    #[serde(alias = "rz")]
+    Yaw,
 }
 
 impl Dof {
-    pub const ALL: [Dof; 6] = [Dof::X, Dof::Y, Dof::Z, Dof::Rx, Dof::Ry, Dof::Rz];
+    pub const ALL: [Dof; 6] = [
+        Dof::Surge,
+        Dof::Sway,
+        Dof::Heave,
+        Dof::Roll,
+        Dof::Pitch,
+        Dof::Yaw,
+    ];
     pub fn index(self) -> usize {
         self as usize
     }

@@ -2,8 +2,9 @@
 //! flow speed, not the speed of sound. Each step
 //!
 //! 1. builds every liquid particle's list of liquid neighbours with their kernel gradients, sums the density,
-//!    the DFSPH factor α = 1 / (|Σ m∇W|² + Σ|m∇W|²), the walls' Σ m_b∇W (walls are at rest in the tank
-//!    frame, so every wall term of the solver is this sum times the particle's own k or velocity), and adds
+//!    the DFSPH factor α = 1 / (|Σ m∇W|² + Σ|m∇W|²), the walls' Σ m_b∇W (walls keep their velocity through
+//!    the step, so every wall term of the solver is this sum times the particle's own k or velocity, plus
+//!    the moving walls' constant Σ m_b v_b·∇W), and adds
 //!    the non-pressure accelerations (the tank frame's apparent gravity and rotation terms, Monaghan's
 //!    artificial viscosity as in the weakly-compressible scheme);
 //! 2. takes dt = CFL · dp / |v|max (also bounded by the accelerations, `dt_max`, and the iteration control:
@@ -17,8 +18,9 @@
 //!    divergence solve, at half the step (nothing has moved yet);
 //! 4. moves the particles with the corrected velocity.
 //!
-//! Walls are the dynamic boundary's particle layers, static in the tank frame, taking part in the density
-//! sums with their volume and pushing back with the liquid particle's own k (Akinci et al. 2012, as
+//! Walls are the dynamic boundary's particle layers (at rest in the tank frame, or moving with a floating
+//! body or a wave maker: their velocities enter the density rate and the viscosity), taking part in the
+//! density sums with their volume and pushing back with the liquid particle's own k (Akinci et al. 2012, as
 //! SPlisHSPlasH's DFSPH). Their reaction, summed once from the final k, gives the wrench; wall pressure
 //! sensors read the liquid's force on the wall particles (`observe::wall_pressure`). The iterations reuse
 //! the neighbour lists; every pass is a gather over fixed chunks that writes only its own particles, so
@@ -69,13 +71,16 @@ struct Lists<const D: usize> {
     start: Vec<u32>,
     j: Vec<u32>,
     g: Vec<[f32; D]>,
-    /// Per particle of the chunk: Σ_b m_b ∇W_ab over its wall neighbours (walls are at rest in the tank
-    /// frame, so every wall term of the solver is this sum times the particle's own k or velocity), the
+    /// Per particle of the chunk: Σ_b m_b ∇W_ab over its wall neighbours (every wall term of the solver is
+    /// this sum times the particle's own k or velocity, and `wf`), the
     /// walls' moment about the tank origin per unit k, Σ_b x_b × (−MIRROR m_b ∇W_ab), and whether the
     /// particle has a full neighbourhood (not at the free surface).
     gb: Vec<[f32; D]>,
     mb: Vec<[f32; 3]>,
     full: Vec<bool>,
+    /// Per particle: Σ_b m_b v_b·∇W_ab, what moving walls (floating bodies, a wave maker) add to the rate of
+    /// change of its density (0 beside walls at rest).
+    wf: Vec<f32>,
 }
 
 /// What the passes over the chunks return, merged in chunk order.
@@ -157,6 +162,8 @@ struct Hood<const D: usize> {
     moment: [f32; 3],
     /// Σ_b x_b × (−MIRROR m_b ∇W_ab): the walls' pressure moment per unit k.
     mb: [f32; 3],
+    /// Σ_b m_b v_b·∇W_ab.
+    wflux: f32,
     /// Liquid and wall neighbours within the support.
     liquid: u32,
     walls: u32,
@@ -172,11 +179,11 @@ struct HoodLanes<const D: usize> {
     wall: [[f32; LANES]; D],
     moment: [[f32; LANES]; 3],
     mb: [[f32; LANES]; 3],
+    wflux: [f32; LANES],
     walls: [f32; LANES],
 }
 
-/// The neighbourhood of liquid particle (xa, va) among the candidates of its cell (liquid `fc`, walls `bc`,
-/// at rest in the tank frame); appends its liquid neighbours (not itself) and their ∇W_ab to `j`/`g`.
+/// The neighbourhood of liquid particle (xa, va) among the candidates of its cell (liquid `fc`, walls `bc`); appends its liquid neighbours (not itself) and their ∇W_ab to `j`/`g`.
 /// Branch-free over blocks of [`LANES`]: candidates beyond the support add nothing.
 #[inline(always)]
 fn hood<const D: usize, K: Kernel>(
@@ -197,6 +204,7 @@ fn hood<const D: usize, K: Kernel>(
         wall: [z; D],
         moment: [z; 3],
         mb: [z; 3],
+        wflux: z,
         walls: z,
     };
     let first = j.len();
@@ -241,7 +249,7 @@ fn hood<const D: usize, K: Kernel>(
         }
     }
     for blk in 0..bc.motion_blocks() {
-        let (xs, _, _) = bc.motion_block(blk);
+        let (xs, vs, _) = bc.motion_block(blk);
         for l in 0..LANES {
             let mut dx = [0.0f32; D];
             let mut r2 = 0.0f32;
@@ -249,7 +257,7 @@ fn hood<const D: usize, K: Kernel>(
             for d in 0..D {
                 dx[d] = xa[d] - xs[d][l];
                 r2 += dx[d] * dx[d];
-                vr += va[d] * dx[d];
+                vr += (va[d] - vs[d][l]) * dx[d];
             }
             let fin = if r2 < c.pair.support2 { 1.0f32 } else { 0.0 };
             let r = r2.sqrt();
@@ -262,6 +270,7 @@ fn hood<const D: usize, K: Kernel>(
             for d in 0..D {
                 let gd = gf * dx[d];
                 s.grad_b[d][l] += mw * gd;
+                s.wflux[l] += mw * vs[d][l] * gd;
                 pair[d] = -mw * pi * gd;
                 fk[d] = -MIRROR * mw * gd;
                 s.visc[d][l] += pair[d];
@@ -285,6 +294,7 @@ fn hood<const D: usize, K: Kernel>(
         wall: std::array::from_fn(|d| lane_sum(&s.wall[d])),
         moment: std::array::from_fn(|d| lane_sum(&s.moment[d])),
         mb: std::array::from_fn(|d| lane_sum(&s.mb[d])),
+        wflux: lane_sum(&s.wflux),
         liquid: (j.len() - first) as u32,
         walls: lane_sum(&s.walls) as u32,
     }
@@ -319,6 +329,7 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.j.clear();
     lists.g.clear();
     lists.gb.clear();
+    lists.wf.clear();
     lists.mb.clear();
     lists.full.clear();
     let mut filled = u32::MAX;
@@ -332,6 +343,7 @@ fn build_chunk<const D: usize, K: Kernel>(
             factor[o] = 0.0;
             acc[o] = [0.0; D];
             lists.gb.push([0.0; D]);
+            lists.wf.push(0.0);
             lists.mb.push([0.0; 3]);
             lists.full.push(false);
             continue;
@@ -369,6 +381,7 @@ fn build_chunk<const D: usize, K: Kernel>(
             + hd.sq;
         rho[o] = hd.density;
         lists.gb.push(grad_b);
+        lists.wf.push(hd.wflux);
         lists.mb.push(hd.mb);
         lists
             .full
@@ -442,6 +455,7 @@ fn error_chunk<const D: usize>(
         for d in 0..D {
             s += va[d] * gb[d];
         }
+        s -= lists.wf[o];
         let (e, kk) = match mode {
             Mode::Density => {
                 let e = (rho[o] + dt * s - c.rho_rest).max(0.0);
@@ -512,6 +526,11 @@ fn wall_chunk<const D: usize>(c: &Coefficients, lists: &Lists<D>, ksum: &[f32]) 
 }
 
 impl<const D: usize> Workspace<D> {
+    /// Starts the step control at `dt` (it grows from there as the solves allow) instead of unlimited.
+    pub fn start_at(&mut self, dt: f64) {
+        self.dt_cap = dt;
+    }
+
     fn resize(&mut self, n: usize) {
         self.lists.resize_with(n.div_ceil(CHUNK), Default::default);
         self.candidates
