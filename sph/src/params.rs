@@ -369,8 +369,8 @@ impl SimParams {
         Some((thickness, face))
     }
 
-    /// Floating bodies need the symplectic WCSPH scheme with wall particle layers, each checked against the
-    /// tank.
+    /// Floating bodies need wall particle layers (and with WCSPH its symplectic integrator), each checked
+    /// against the tank.
     fn validate_bodies(&self) -> Result<(), ParamError> {
         if let (Some(wm), Some((thickness, _))) = (&self.wave_maker, self.wave_maker_plate()) {
             wm.validate(self.tank.length, thickness, self.particle_spacing)?;

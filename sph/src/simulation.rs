@@ -307,7 +307,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             });
         }
         let frame_at_start = self.frame(motion, t);
-        let r = self.solve_dfsph(motion, room.min(self.body_step_limit()), false)?;
+        if !self.bodies.is_empty() {
+            let limit = self.body_step_limit();
+            self.dwork.bound(limit);
+        }
+        let r = self.solve_dfsph(motion, room, false)?;
         let spec = &self.params.solver.dfsph;
         let st = &mut self.stats;
         let its = r.density_iterations + r.divergence_iterations;
@@ -796,6 +800,22 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             // with the particles where they are now.
             if !self.rates_current {
                 self.solve_dfsph(motion, self.params.solver.dfsph.dt_max, true)?;
+                if !self.bodies.is_empty() {
+                    // The liquid's force on the bodies in this state (no step made it yet).
+                    let frame = self.frame(motion, self.time);
+                    let (f, w) = (&self.fluid, &self.dwork);
+                    coupling::liquid_forces_dfsph(
+                        &self.kernel,
+                        &self.dcoef,
+                        &self.grid,
+                        f,
+                        &self.bound,
+                        |a| w.total_k(a),
+                        &self.bodies.slots,
+                        &mut self.bodies.forces,
+                    );
+                    self.accelerate_bodies(&frame, true);
+                }
             }
             self.rebin(self.time, false)?;
             self.fluid.refresh(|_, p| p as f32);
@@ -1220,9 +1240,11 @@ fn rest_density<const D: usize, K: Kernel>(
             .map(|d| (fluid.pos[d][i] - centre[d]).powi(2))
             .sum::<f64>()
     };
+    // (If every particle is excluded, the nearest of all.)
     let Some(a) = (0..n)
         .filter(|&i| !excluded(fluid.position(i)))
         .min_by(|&i, &j| dist2(i).total_cmp(&dist2(j)))
+        .or_else(|| (0..n).min_by(|&i, &j| dist2(i).total_cmp(&dist2(j))))
     else {
         return 0.0;
     };

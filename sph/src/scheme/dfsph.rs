@@ -117,6 +117,8 @@ pub struct Workspace<const D: usize> {
     kdiv: Vec<f32>,
     /// Longest step the iteration control allows now (0: no limit yet).
     dt_cap: f64,
+    /// Longest step something else (moving bodies) allows (0: none).
+    dt_bound: f64,
     partials: Vec<Partial>,
 }
 
@@ -531,6 +533,17 @@ impl<const D: usize> Workspace<D> {
         self.dt_cap = dt;
     }
 
+    /// Bounds the next steps by `dt` (∞: no bound), beside the flow's own limits and the iteration control.
+    pub fn bound(&mut self, dt: f64) {
+        self.dt_bound = if dt.is_finite() { dt } else { 0.0 };
+    }
+
+    /// Each particle's total k of the last solve: the constant-density and divergence solves' (what the
+    /// walls' push-back used).
+    pub fn total_k(&self, a: usize) -> f32 {
+        self.ksum[a] + self.kdiv[a]
+    }
+
     fn resize(&mut self, n: usize) {
         self.lists.resize_with(n.div_ceil(CHUNK), Default::default);
         self.candidates
@@ -727,6 +740,9 @@ pub fn step<'r, const D: usize, K: Kernel>(
     }
     if amax > 0.0 {
         dt = dt.min(spec.cfl * (dp / amax).sqrt());
+    }
+    if work.dt_bound > 0.0 {
+        dt = dt.min(work.dt_bound);
     }
     let mut control = spec.target_iterations > 0 && !prime;
     if control && work.dt_cap > 0.0 {
