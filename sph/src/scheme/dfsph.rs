@@ -866,21 +866,22 @@ mod tests {
 
     /// The neighbourhood sums written the plain way: one pair at a time in f64 over every particle, skipping
     /// itself and pairs beyond the support. Returns (density, Σ m∇W liquid, Σ m∇W walls, Σ|m∇W|², viscous
-    /// acceleration, liquid neighbours in order).
+    /// acceleration, liquid neighbours in order, the moving walls' Σ m_b v_b·∇W).
     #[allow(clippy::type_complexity)]
     fn naive<const D: usize, K: Kernel>(
         k: &K,
         c: &Coefficients,
         a: usize,
         (x, v): (&[Vec<f32>; D], &[Vec<f32>; D]),
-        xb: &[Vec<f32>; D],
-    ) -> (f64, [f64; D], [f64; D], f64, [f64; D], Vec<u32>) {
+        (xb, vw): (&[Vec<f32>; D], &[Vec<f32>; D]),
+    ) -> (f64, [f64; D], [f64; D], f64, [f64; D], Vec<u32>, f64) {
         let xa: [f64; D] = std::array::from_fn(|d| x[d][a] as f64);
         let va: [f64; D] = std::array::from_fn(|d| v[d][a] as f64);
         let (mf, mw) = (c.pair.m_fluid as f64, c.pair.m_bound as f64);
         let mut density = mf * k.w(0.0) as f64;
         let (mut grad, mut grad_b, mut sq, mut visc) = ([0.0; D], [0.0; D], 0.0, [0.0; D]);
         let mut list = Vec::new();
+        let mut wflux = 0.0;
         for (wall, xs, n) in [(false, x, x[0].len()), (true, xb, xb[0].len())] {
             for j in 0..n {
                 if !wall && j == a {
@@ -891,7 +892,13 @@ mod tests {
                 if r2 >= c.pair.support2 as f64 {
                     continue;
                 }
-                let vb: [f64; D] = std::array::from_fn(|d| if wall { 0.0 } else { v[d][j] as f64 });
+                let vb: [f64; D] = std::array::from_fn(|d| {
+                    if wall {
+                        vw[d][j] as f64
+                    } else {
+                        v[d][j] as f64
+                    }
+                });
                 let vr: f64 = (0..D).map(|d| (va[d] - vb[d]) * dx[d]).sum();
                 let r = r2.sqrt();
                 let gf = k.grad_factor(r as f32) as f64;
@@ -907,6 +914,7 @@ mod tests {
                     let g = gf * dx[d];
                     if wall {
                         grad_b[d] += m * g;
+                        wflux += m * vb[d] * g;
                     } else {
                         grad[d] += m * g;
                         sq += m * m * g * g;
@@ -918,7 +926,7 @@ mod tests {
                 }
             }
         }
-        (density, grad, grad_b, sq, visc, list)
+        (density, grad, grad_b, sq, visc, list, wflux)
     }
 
     fn check<const D: usize, K: Kernel>() {
@@ -972,7 +980,9 @@ mod tests {
                 });
             }
         }
-        let vb: [Vec<f32>; D] = std::array::from_fn(|_| vec![0.0; xb[0].len()]);
+        // The walls move (a floating body's): their velocities enter the viscosity and the wall flux.
+        let vb: [Vec<f32>; D] =
+            std::array::from_fn(|_| (0..xb[0].len()).map(|_| 0.3 * rnd()).collect());
         let mut ranges = NO_RANGES;
         ranges[0] = (0, x[0].len() as u32);
         let mut fc = Candidates::<D>::default();
@@ -983,7 +993,8 @@ mod tests {
         // The middle particle and one in the bottom row.
         let n = x[0].len();
         for a in [n / 2, n1 / 2] {
-            let (density, grad, grad_b, sq, visc, list) = naive(&k, &c, a, (&x, &v), &xb);
+            let (density, grad, grad_b, sq, visc, list, wflux) =
+                naive(&k, &c, a, (&x, &v), (&xb, &vb));
             let own = (
                 std::array::from_fn(|d| x[d][a]),
                 std::array::from_fn(|d| v[d][a]),
@@ -1018,6 +1029,8 @@ mod tests {
                     );
                     assert!((s.visc[d] as f64 - visc[d]).abs() < 1e-3 * vs, "visc {d}");
                 }
+                let fs = gs * 0.3 * D as f64;
+                assert!((s.wflux as f64 - wflux).abs() < 1e-4 * fs, "wall flux");
                 assert_eq!(j, &list, "liquid neighbours");
                 assert_eq!(s.liquid as usize, list.len());
             }
@@ -1026,6 +1039,7 @@ mod tests {
                 "a real neighbourhood"
             );
             assert!(grad_b.iter().any(|q| q.abs() > 0.0), "walls in reach");
+            assert!(wflux.abs() > 0.0, "moving walls in reach");
         }
     }
 
