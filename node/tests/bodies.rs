@@ -26,24 +26,6 @@ const COARSE: [&str; 16] = [
     "bodies.box.openings.damage={centre: [0.0, 0.0, 0.0075], size: [0.02, 1.0, 0.03]}",
 ];
 
-/// bodies.csv: its header and rows (the body's name in the second column).
-fn bodies_csv(path: &std::path::Path) -> (Vec<String>, Vec<(String, Vec<f64>)>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| {
-            let mut f = l.split(',');
-            let t: f64 = f.next().unwrap().parse().unwrap();
-            let name = f.next().unwrap().to_string();
-            let mut v = vec![t];
-            v.extend(f.map(|x| x.parse::<f64>().unwrap()));
-            (name, v)
-        })
-        .collect();
-    (header, rows)
-}
-
 #[test]
 fn walls_thinner_than_the_kernel_are_refused_by_name() {
     let out = slosh()
@@ -87,7 +69,7 @@ fn a_damaged_box_floods_and_its_motion_is_recorded_as_odometry() {
         .status()
         .unwrap();
     assert!(st.success());
-    let (header, rows) = bodies_csv(&dir.join("out/bodies.csv"));
+    let (header, rows) = common::bodies_csv(&dir.join("out/bodies.csv"));
     assert_eq!(header.len(), 22);
     assert_eq!(&header[..5], ["time", "body", "x", "y", "z"]);
     assert_eq!(rows.len(), 11, "t = 0, 0.025, …, 0.25");

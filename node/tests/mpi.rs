@@ -276,23 +276,6 @@ fn a_failure_stops_all_ranks_and_is_reported_once() {
     assert!(err.contains("run on at most 7 ranks"), "{err}");
 }
 
-/// bodies.csv without its name column: (header, rows).
-fn bodies_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .enumerate()
-                .filter(|(i, _)| *i != 1)
-                .map(|(_, v)| v.parse().unwrap())
-                .collect()
-        })
-        .collect();
-    (header, rows)
-}
-
 /// A damaged box (the paper's case A at twice the size, dp = 5 mm) floating across the cut between two
 /// ranks: each rank sums its own liquid's force on the box, so the box moves as in one process, up to the
 /// order of those sums.
@@ -325,12 +308,12 @@ fn a_floating_box_across_ranks_moves_as_in_one_process() {
         summary(&two)["particles_fluid"],
         summary(&serial)["particles_fluid"]
     );
-    let (h, a) = bodies_csv(&serial.join("bodies.csv"));
-    let (_, b) = bodies_csv(&two.join("bodies.csv"));
+    let (h, a) = common::bodies_csv(&serial.join("bodies.csv"));
+    let (_, b) = common::bodies_csv(&two.join("bodies.csv"));
     assert_eq!(a.len(), b.len());
     let col = |name: &str| h.iter().position(|c| c == name).unwrap() - 1;
     let mut worst = [0.0f64; 3];
-    for (x, y) in a.iter().zip(&b) {
+    for ((_, x), (_, y)) in a.iter().zip(&b) {
         for (w, c) in worst.iter_mut().zip(["z", "pitch", "flooded_volume"]) {
             *w = w.max((x[col(c)] - y[col(c)]).abs());
         }
@@ -339,7 +322,7 @@ fn a_floating_box_across_ranks_moves_as_in_one_process() {
         "serial vs 2 ranks: z {:.2e} m, pitch {:.2e} rad, flooded {:.2e} m²",
         worst[0], worst[1], worst[2]
     );
-    let last = &a[a.len() - 1];
+    let last = &a[a.len() - 1].1;
     assert!(last[col("flooded_volume")] > 1e-4 && last[col("pitch")].abs() > 1e-3);
     assert!(worst[0] < 1e-5 && worst[1] < 1e-4 && worst[2] < 1e-3 * last[col("flooded_volume")]);
 }

@@ -551,13 +551,17 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             &mut self.bodies.forces,
         );
         self.accelerate_bodies(frame, true);
-        let (lo, hi) = (to3(self.tank.lo), to3(self.tank.hi));
-        let axes: &[usize] = if D == 2 { &[0, 2] } else { &[0, 1, 2] };
         for b in self.bodies.list.iter_mut() {
             b.advance(t, dt);
-            if !b.is_driven() {
-                b.contain(lo.into(), hi.into(), self.params.particle_spacing, axes);
-            }
+        }
+        self.contain_bodies();
+    }
+
+    /// Bodies rest on the tank's walls: their particles stay a spacing inside the inner faces.
+    fn contain_bodies(&mut self) {
+        let (lo, hi) = (to3(self.tank.lo).into(), to3(self.tank.hi).into());
+        for b in self.bodies.list.iter_mut() {
+            b.contain(lo, hi, self.params.particle_spacing);
         }
     }
 
@@ -750,16 +754,10 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                     walls.then_some(&mut self.bound),
                     dt,
                 );
-                let (lo, hi) = (to3(self.tank.lo), to3(self.tank.hi));
-                let axes: &[usize] = if D == 2 { &[0, 2] } else { &[0, 1, 2] };
                 for b in self.bodies.list.iter_mut() {
                     b.correct(t, dt);
-                    if b.is_driven() {
-                        continue;
-                    }
-                    // Bodies rest on the tank's walls, their particles a spacing inside the inner faces.
-                    b.contain(lo.into(), hi.into(), self.params.particle_spacing, axes);
                 }
+                self.contain_bodies();
             }
             Integrator::Verlet => {
                 let euler = self

@@ -153,6 +153,25 @@ pub fn csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {
     (header, rows)
 }
 
+/// `bodies.csv` written by `slosh run`: its header and rows (the body's name, then the row's numbers with
+/// the time first: column `c` of the header is value `c - 1`).
+pub fn bodies_csv(path: &std::path::Path) -> (Vec<String>, Vec<(String, Vec<f64>)>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            let mut f = l.split(',');
+            let t: f64 = f.next().unwrap().parse().unwrap();
+            let name = f.next().unwrap().to_string();
+            let mut v = vec![t];
+            v.extend(f.map(|x| x.parse::<f64>().unwrap()));
+            (name, v)
+        })
+        .collect();
+    (header, rows)
+}
+
 /// `mpirun -n RANKS slosh` (OpenMPI), kept on this machine: shared memory between ranks, loopback for the
 /// launcher, more ranks than cores allowed, and allowed as root (CI runs as root).
 pub fn mpirun(ranks: usize) -> Command {

@@ -9,8 +9,37 @@ use crate::scheme::wcsph::Coefficients;
 use crate::tank::to3;
 use rayon::prelude::*;
 
+/// Calls `pair(j, dx, vd, r2)` for every liquid particle j of this rank (halo copies, MPI, are left out:
+/// each rank adds its own liquid's part) within the support of boundary particle b, with dx = x_j − x_b,
+/// vd = v_j − v_b and r2 = |dx|².
+fn each_liquid_neighbour<const D: usize>(
+    grid: &Grid<D>,
+    fluid: &Fluid<D>,
+    bound: &Boundary<D>,
+    b: usize,
+    support2: f32,
+    mut pair: impl FnMut(usize, [f32; D], [f32; D], f32),
+) {
+    let xb: [f32; D] = std::array::from_fn(|d| bound.x[d][b]);
+    let vb: [f32; D] = std::array::from_fn(|d| bound.v[d][b]);
+    let mut ranges = NO_RANGES;
+    let n = grid.ranges(bound.cell[b], &fluid.starts, &mut ranges);
+    for &(lo, hi) in &ranges[..n] {
+        for j in lo as usize..hi as usize {
+            if fluid.id[j] & HALO != 0 {
+                continue;
+            }
+            let dx: [f32; D] = std::array::from_fn(|d| fluid.x[d][j] - xb[d]);
+            let vd: [f32; D] = std::array::from_fn(|d| fluid.v[d][j] - vb[d]);
+            let r2: f32 = (0..D).map(|d| dx[d] * dx[d]).sum();
+            if r2 < support2 {
+                pair(j, dx, vd, r2);
+            }
+        }
+    }
+}
+
 /// Force of the liquid on the boundary particles at `slots` (x, y, z; per unit breadth in 2D), into `out`.
-/// Halo copies (MPI) are left out: each rank adds its own liquid's part.
 pub fn liquid_forces<const D: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
@@ -24,48 +53,28 @@ pub fn liquid_forces<const D: usize, K: Kernel>(
         .par_iter()
         .map(|&b| {
             let b = b as usize;
-            let xb: [f32; D] = std::array::from_fn(|d| bound.x[d][b]);
-            let vb: [f32; D] = std::array::from_fn(|d| bound.v[d][b]);
             let (rb, pb_r2) = (bound.r[b], bound.pr2[b]);
-            let mut ranges = NO_RANGES;
-            let n = grid.ranges(bound.cell[b], &fluid.starts, &mut ranges);
             let mut force = [0.0f64; D];
-            for &(lo, hi) in &ranges[..n] {
-                for j in lo as usize..hi as usize {
-                    if fluid.id[j] & HALO != 0 {
-                        continue;
-                    }
-                    let mut dx = [0.0f32; D];
-                    let mut vd = [0.0f32; D];
-                    let (mut r2, mut vr) = (0.0f32, 0.0f32);
-                    for d in 0..D {
-                        dx[d] = fluid.x[d][j] - xb[d];
-                        vd[d] = fluid.v[d][j] - vb[d];
-                        r2 += dx[d] * dx[d];
-                        vr += vd[d] * dx[d];
-                    }
-                    if r2 >= c.support2 {
-                        continue;
-                    }
-                    let f = k.grad_factor(r2.sqrt());
-                    let ra = fluid.r[j];
-                    let inv_r2e = 1.0 / (r2 + c.eta2);
-                    let mu = c.h * vr.min(0.0) * inv_r2e;
-                    let s = fluid.pr2[j]
-                        + pb_r2
-                        + (-c.alpha_bound * c.c0 * mu + c.beta_bound * mu * mu) * 2.0 / (ra + rb);
-                    let lam = if c.nu4 > 0.0 {
-                        c.m_bound * c.nu4 * f * r2 * inv_r2e / (ra + rb)
-                    } else {
-                        0.0
-                    };
-                    // The acceleration the body particle gives liquid particle j, and its reaction.
-                    for d in 0..D {
-                        let pair = -c.m_bound * s * f * dx[d] + lam * vd[d];
-                        force[d] -= (c.m_fluid * pair) as f64;
-                    }
+            each_liquid_neighbour(grid, fluid, bound, b, c.support2, |j, dx, vd, r2| {
+                let vr: f32 = (0..D).map(|d| vd[d] * dx[d]).sum();
+                let f = k.grad_factor(r2.sqrt());
+                let ra = fluid.r[j];
+                let inv_r2e = 1.0 / (r2 + c.eta2);
+                let mu = c.h * vr.min(0.0) * inv_r2e;
+                let s = fluid.pr2[j]
+                    + pb_r2
+                    + (-c.alpha_bound * c.c0 * mu + c.beta_bound * mu * mu) * 2.0 / (ra + rb);
+                let lam = if c.nu4 > 0.0 {
+                    c.m_bound * c.nu4 * f * r2 * inv_r2e / (ra + rb)
+                } else {
+                    0.0
+                };
+                // The acceleration the body particle gives liquid particle j, and its reaction.
+                for d in 0..D {
+                    let pair = -c.m_bound * s * f * dx[d] + lam * vd[d];
+                    force[d] -= (c.m_fluid * pair) as f64;
                 }
-            }
+            });
             to3(force)
         })
         .collect_into_vec(out);
@@ -90,27 +99,15 @@ pub fn liquid_forces_dfsph<const D: usize, K: Kernel>(
     slots
         .par_iter()
         .map(|&b| {
-            let b = b as usize;
-            let xb: [f32; D] = std::array::from_fn(|d| bound.x[d][b]);
-            let vb: [f32; D] = std::array::from_fn(|d| bound.v[d][b]);
-            let mut ranges = NO_RANGES;
-            let n = grid.ranges(bound.cell[b], &fluid.starts, &mut ranges);
             let mut force = [0.0f64; D];
-            for &(lo, hi) in &ranges[..n] {
-                for j in lo as usize..hi as usize {
-                    if fluid.id[j] & HALO != 0 {
-                        continue;
-                    }
-                    let mut dx = [0.0f32; D];
-                    let (mut r2, mut vr) = (0.0f32, 0.0f32);
-                    for d in 0..D {
-                        dx[d] = fluid.x[d][j] - xb[d];
-                        r2 += dx[d] * dx[d];
-                        vr += (fluid.v[d][j] - vb[d]) * dx[d];
-                    }
-                    if r2 >= p.support2 {
-                        continue;
-                    }
+            each_liquid_neighbour(
+                grid,
+                fluid,
+                bound,
+                b as usize,
+                p.support2,
+                |j, dx, vd, r2| {
+                    let vr: f32 = (0..D).map(|d| vd[d] * dx[d]).sum();
                     let gf = k.grad_factor(r2.sqrt());
                     let mu = p.h * vr.min(0.0) / (r2 + p.eta2);
                     let pi = -p.alpha_bound * p.c0 * mu / c.rho_rest;
@@ -121,8 +118,8 @@ pub fn liquid_forces_dfsph<const D: usize, K: Kernel>(
                             - p.m_bound * pi * gf * dx[d];
                         force[d] -= (p.m_fluid * acc) as f64;
                     }
-                }
-            }
+                },
+            );
             to3(force)
         })
         .collect_into_vec(out);

@@ -158,11 +158,6 @@ impl RigidBody {
         }
     }
 
-    /// Whether the body follows a prescribed motion (a wave maker) instead of forces.
-    pub fn is_driven(&self) -> bool {
-        self.drive.is_some()
-    }
-
     /// The artificial added mass of [`Self::accelerate_relaxed`]: the liquid that fills the box's outer
     /// volume (density `rho`; 2D: per metre), and its moments of inertia about the centre of the box.
     pub fn liquid_of_box(&self, rho: f64, dimension: usize) -> (f64, V3) {
@@ -339,24 +334,27 @@ impl RigidBody {
 
 impl RigidBody {
     /// Keeps the body's particles at least `gap` inside the tank's box (`lo`, `hi`, tank frame) along the
-    /// `axes` (those it may move along): a body that reaches a wall is moved back onto it and loses its
-    /// velocity into the wall (an inelastic contact, without friction or the contact's moment). Returns
-    /// whether it touched.
-    pub fn contain(&mut self, lo: V3, hi: V3, gap: f64, axes: &[usize]) -> bool {
+    /// axes it may move along (none for a fixed or driven body): a body that reaches a wall is moved back
+    /// onto it and loses its velocity into the wall (an inelastic contact, without friction or the
+    /// contact's moment). Returns whether it touched.
+    pub fn contain(&mut self, lo: V3, hi: V3, gap: f64) -> bool {
+        if !self.free[..3].contains(&true) {
+            return false;
+        }
+        let (mut min, mut max) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
+        for r in &self.local {
+            let x = self.now.cog + self.now.rot * r;
+            min = min.inf(&x);
+            max = max.sup(&x);
+        }
         let mut touched = false;
-        for &k in axes.iter().filter(|&&k| self.free[k]) {
-            let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
-            for i in 0..self.local.len() {
-                let x = self.now.cog[k] + (self.now.rot * self.local[i])[k];
-                min = min.min(x);
-                max = max.max(x);
-            }
-            if min < lo[k] + gap {
-                self.now.cog[k] += lo[k] + gap - min;
+        for k in (0..3).filter(|&k| self.free[k]) {
+            if min[k] < lo[k] + gap {
+                self.now.cog[k] += lo[k] + gap - min[k];
                 self.now.vel[k] = self.now.vel[k].max(0.0);
                 touched = true;
-            } else if max > hi[k] - gap {
-                self.now.cog[k] -= max - (hi[k] - gap);
+            } else if max[k] > hi[k] - gap {
+                self.now.cog[k] -= max[k] - (hi[k] - gap);
                 self.now.vel[k] = self.now.vel[k].min(0.0);
                 touched = true;
             }
@@ -459,7 +457,7 @@ mod tests {
             b.predict(0.0, 1e-3);
             b.accelerate(V3::zeros(), V3::zeros(), &frame);
             b.correct(0.0, 1e-3);
-            touched |= b.contain(lo, hi, 0.01, &[0, 2]);
+            touched |= b.contain(lo, hi, 0.01);
         }
         assert!(touched);
         // Its lowest particle (the bottom face, 0.05 below the centre of gravity) rests 0.01 above the floor.
