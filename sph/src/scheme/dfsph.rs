@@ -210,7 +210,16 @@ fn hood<const D: usize, K: Kernel>(
         walls: z,
     };
     let first = j.len();
+    // Every lane is written after the end of the list and kept only if it is a neighbour (no branches on
+    // whether it is).
+    j.reserve(fc.motion_blocks() * LANES);
+    g.reserve(fc.motion_blocks() * LANES);
+    let (js, gs) = (j.spare_capacity_mut(), g.spare_capacity_mut());
+    let mut n = 0;
     let (mf, mw) = (c.pair.m_fluid, c.pair.m_bound);
+    // Monaghan's Π_ab = −α c0 h min(v_ab·x_ab, 0) / ((r² + η²) ρ_rest): the constant factor of each.
+    let visc = c.pair.alpha * c.pair.c0 * c.pair.h / c.rho_rest;
+    let visc_b = c.pair.alpha_bound * c.pair.c0 * c.pair.h / c.rho_rest;
     for blk in 0..fc.motion_blocks() {
         let (xs, vs, idx) = fc.motion_block(blk);
         let mut gl = [z; D];
@@ -230,8 +239,7 @@ fn hood<const D: usize, K: Kernel>(
             let gf = k.grad_factor(r) * fin;
             s.density[l] += mf * k.w(r) * fin;
             // Monaghan's artificial viscosity on approaching pairs, densities at ρ_rest.
-            let mu = c.pair.h * vr.min(0.0) / (r2 + c.pair.eta2);
-            let pi = -c.pair.alpha * c.pair.c0 * mu / c.rho_rest;
+            let pi = -visc * vr.min(0.0) / (r2 + c.pair.eta2);
             let mut g2 = 0.0f32;
             for d in 0..D {
                 let gd = gf * dx[d];
@@ -244,11 +252,15 @@ fn hood<const D: usize, K: Kernel>(
             hit[l] = inside && r2 > 0.0;
         }
         for l in 0..LANES {
-            if hit[l] {
-                j.push(idx[l]);
-                g.push(std::array::from_fn(|d| gl[d][l]));
-            }
+            js[n].write(idx[l]);
+            gs[n].write(std::array::from_fn(|d| gl[d][l]));
+            n += hit[l] as usize;
         }
+    }
+    // SAFETY: the first n entries of the spare capacity were written above.
+    unsafe {
+        j.set_len(first + n);
+        g.set_len(first + n);
     }
     for blk in 0..bc.motion_blocks() {
         let (xs, vs, _) = bc.motion_block(blk);
@@ -265,8 +277,7 @@ fn hood<const D: usize, K: Kernel>(
             let r = r2.sqrt();
             let gf = k.grad_factor(r) * fin;
             s.density[l] += mw * k.w(r) * fin;
-            let mu = c.pair.h * vr.min(0.0) / (r2 + c.pair.eta2);
-            let pi = -c.pair.alpha_bound * c.pair.c0 * mu / c.rho_rest;
+            let pi = -visc_b * vr.min(0.0) / (r2 + c.pair.eta2);
             let mut pair = [0.0f32; D];
             let mut fk = [0.0f32; D];
             for d in 0..D {
@@ -297,7 +308,7 @@ fn hood<const D: usize, K: Kernel>(
         moment: std::array::from_fn(|d| lane_sum(&s.moment[d])),
         mb: std::array::from_fn(|d| lane_sum(&s.mb[d])),
         wflux: lane_sum(&s.wflux),
-        liquid: (j.len() - first) as u32,
+        liquid: n as u32,
         walls: lane_sum(&s.walls) as u32,
     }
 }
@@ -416,6 +427,38 @@ fn build_chunk<const D: usize, K: Kernel>(
     out
 }
 
+/// Independent partial sums a neighbour-list loop keeps, so that consecutive pairs do not wait for each
+/// other's additions (one chain per dimension is bound by the adder's latency, not its throughput).
+const CHAINS: usize = 4;
+
+/// Σ over a particle's neighbour list of `term(j, ∇W)`, summed in [`CHAINS`] interleaved partial sums (a
+/// fixed order: the result depends only on the list, not on threads).
+#[inline(always)]
+fn pair_sum<const D: usize>(
+    j: &[u32],
+    g: &[[f32; D]],
+    term: impl Fn(u32, &[f32; D]) -> [f32; D],
+) -> [f32; D] {
+    let mut acc = [[0.0f32; D]; CHAINS];
+    let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
+    let (gc, gr) = g.split_at(jc.len());
+    for (js, gs) in jc.chunks_exact(CHAINS).zip(gc.chunks_exact(CHAINS)) {
+        for l in 0..CHAINS {
+            let t = term(js[l], &gs[l]);
+            for d in 0..D {
+                acc[l][d] += t[d];
+            }
+        }
+    }
+    for (l, (jj, gg)) in jr.iter().zip(gr).enumerate() {
+        let t = term(*jj, gg);
+        for d in 0..D {
+            acc[l][d] += t[d];
+        }
+    }
+    std::array::from_fn(|d| (acc[0][d] + acc[1][d]) + (acc[2][d] + acc[3][d]))
+}
+
 /// Which error a solve removes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Mode {
@@ -429,6 +472,7 @@ enum Mode {
 /// which keeps the Jacobi iteration stable and never sucks liquid together). Returns the summed error
 /// (density units).
 #[allow(clippy::too_many_arguments)]
+#[inline(never)]
 fn error_chunk<const D: usize>(
     c: &Coefficients,
     mode: Mode,
@@ -440,19 +484,18 @@ fn error_chunk<const D: usize>(
     k: &mut [f32],
 ) -> Partial {
     let mut err = 0u64;
+    let (inv_dt, inv_dt2) = (1.0 / dt, 1.0 / (dt * dt));
     for o in 0..k.len() {
         let a = first + o;
         let va = vel[a];
-        // One accumulator per dimension: independent chains the CPU can overlap.
-        let mut acc = [0.0f32; D];
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
-        for (j, g) in lists.j[lo..hi].iter().zip(&lists.g[lo..hi]) {
-            let vb = vel[*j as usize];
-            for d in 0..D {
-                acc[d] += (va[d] - vb[d]) * g[d];
-            }
-        }
-        let mut s = c.pair.m_fluid * acc.iter().sum::<f32>();
+        let mut s = c.pair.m_fluid
+            * pair_sum(&lists.j[lo..hi], &lists.g[lo..hi], |j, g| {
+                let vb = vel[j as usize];
+                std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
+            })
+            .iter()
+            .sum::<f32>();
         let gb = lists.gb[o];
         for d in 0..D {
             s += va[d] * gb[d];
@@ -461,12 +504,12 @@ fn error_chunk<const D: usize>(
         let (e, kk) = match mode {
             Mode::Density => {
                 let e = (rho[o] + dt * s - c.rho_rest).max(0.0);
-                (e, e * factor[o] / (dt * dt))
+                (e, e * factor[o] * inv_dt2)
             }
             Mode::Divergence => {
                 // At the free surface (too few neighbours) the density may fall: no divergence to remove.
                 let e = if lists.full[o] { s.max(0.0) } else { 0.0 };
-                (e * dt, e * factor[o] / dt)
+                (e * dt, e * factor[o] * inv_dt)
             }
         };
         k[o] = kk;
@@ -481,6 +524,7 @@ fn error_chunk<const D: usize>(
 }
 
 /// Pass 3 for one chunk: the velocity change from k (the walls push back with the particle's own k).
+#[inline(never)]
 fn update_chunk<const D: usize>(
     c: &Coefficients,
     dt: f32,
@@ -494,17 +538,14 @@ fn update_chunk<const D: usize>(
         let a = first + o;
         let ka = kall[a];
         ksum[o] += ka;
-        let mut acc = [0.0f32; D];
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
-        for (j, g) in lists.j[lo..hi].iter().zip(&lists.g[lo..hi]) {
-            let s = ka + kall[*j as usize];
-            for d in 0..D {
-                acc[d] -= s * g[d];
-            }
-        }
+        let acc = pair_sum(&lists.j[lo..hi], &lists.g[lo..hi], |j, g| {
+            let s = ka + kall[j as usize];
+            std::array::from_fn(|d| s * g[d])
+        });
         let gb = lists.gb[o];
         for d in 0..D {
-            vel[o][d] += dt * (c.pair.m_fluid * acc[d] - MIRROR * ka * gb[d]);
+            vel[o][d] -= dt * (c.pair.m_fluid * acc[d] + MIRROR * ka * gb[d]);
         }
     }
 }
