@@ -691,5 +691,5 @@ fn dfsph_iteration_control_keeps_every_step_converged() {
         (controlled.solver_iterations as f64 / controlled.steps as f64)
             < (free.solver_iterations as f64 / free.steps as f64)
     );
-    assert!(controlled.max_density_error <= 5.0e-4);
+    assert!(controlled.max_density_error <= sph::params::DfsphSpec::default().max_density_error);
 }

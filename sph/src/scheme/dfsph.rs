@@ -162,7 +162,9 @@ struct Hood<const D: usize> {
     visc: [f32; D],
     wall: [f32; D],
     moment: [f32; 3],
-    /// Σ_b x_b × (−MIRROR m_b ∇W_ab): the walls' pressure moment per unit k.
+    /// Σ_b x_b × (−MIRROR m_b ∇W_ab): the walls' pressure moment per unit k. (Every pair force acts along
+    /// x_a − x_b, so Σ_b x_b × f_b = x_a × Σ_b f_b: the moments are the particle's position crossed with
+    /// the summed forces, not sums over the pairs.)
     mb: [f32; 3],
     /// Σ_b m_b v_b·∇W_ab.
     wflux: f32,
@@ -179,8 +181,6 @@ struct HoodLanes<const D: usize> {
     sq: [f32; LANES],
     visc: [[f32; LANES]; D],
     wall: [[f32; LANES]; D],
-    moment: [[f32; LANES]; 3],
-    mb: [[f32; LANES]; 3],
     wflux: [f32; LANES],
     walls: [f32; LANES],
 }
@@ -204,8 +204,6 @@ fn hood<const D: usize, K: Kernel>(
         sq: z,
         visc: [z; D],
         wall: [z; D],
-        moment: [z; 3],
-        mb: [z; 3],
         wflux: z,
         walls: z,
     };
@@ -278,35 +276,27 @@ fn hood<const D: usize, K: Kernel>(
             let gf = k.grad_factor(r) * fin;
             s.density[l] += mw * k.w(r) * fin;
             let pi = -visc_b * vr.min(0.0) / (r2 + c.pair.eta2);
-            let mut pair = [0.0f32; D];
-            let mut fk = [0.0f32; D];
             for d in 0..D {
                 let gd = gf * dx[d];
                 s.grad_b[d][l] += mw * gd;
                 s.wflux[l] += mw * vs[d][l] * gd;
-                pair[d] = -mw * pi * gd;
-                fk[d] = -MIRROR * mw * gd;
-                s.visc[d][l] += pair[d];
-                s.wall[d][l] += pair[d];
-            }
-            let xb = to3(std::array::from_fn::<f32, D, _>(|d| xs[d][l]));
-            let (m, mk) = (cross(xb, to3(pair)), cross(xb, to3(fk)));
-            for e in 0..3 {
-                s.moment[e][l] += m[e];
-                s.mb[e][l] += mk[e];
+                s.wall[d][l] -= mw * pi * gd;
             }
             s.walls[l] += fin;
         }
     }
+    let wall: [f32; D] = std::array::from_fn(|d| lane_sum(&s.wall[d]));
+    let grad_b: [f32; D] = std::array::from_fn(|d| lane_sum(&s.grad_b[d]));
+    let push: [f32; D] = std::array::from_fn(|d| -MIRROR * grad_b[d]);
     Hood {
         density: lane_sum(&s.density),
         grad: std::array::from_fn(|d| lane_sum(&s.grad[d])),
-        grad_b: std::array::from_fn(|d| lane_sum(&s.grad_b[d])),
+        grad_b,
         sq: lane_sum(&s.sq),
-        visc: std::array::from_fn(|d| lane_sum(&s.visc[d])),
-        wall: std::array::from_fn(|d| lane_sum(&s.wall[d])),
-        moment: std::array::from_fn(|d| lane_sum(&s.moment[d])),
-        mb: std::array::from_fn(|d| lane_sum(&s.mb[d])),
+        visc: std::array::from_fn(|d| lane_sum(&s.visc[d]) + wall[d]),
+        wall,
+        moment: cross(to3(xa), to3(wall)),
+        mb: cross(to3(xa), to3(push)),
         wflux: lane_sum(&s.wflux),
         liquid: n as u32,
         walls: lane_sum(&s.walls) as u32,
@@ -907,7 +897,9 @@ mod tests {
 
     /// The neighbourhood sums written the plain way: one pair at a time in f64 over every particle, skipping
     /// itself and pairs beyond the support. Returns (density, Σ m∇W liquid, Σ m∇W walls, Σ|m∇W|², viscous
-    /// acceleration, liquid neighbours in order, the moving walls' Σ m_b v_b·∇W).
+    /// acceleration, liquid neighbours in order, the moving walls' Σ m_b v_b·∇W), and the walls' viscous
+    /// acceleration with its moment and the pressure moment per unit k, each pair's taken at the wall
+    /// particle (Σ_b x_b × f_b).
     #[allow(clippy::type_complexity)]
     fn naive<const D: usize, K: Kernel>(
         k: &K,
@@ -915,7 +907,10 @@ mod tests {
         a: usize,
         (x, v): (&[Vec<f32>; D], &[Vec<f32>; D]),
         (xb, vw): (&[Vec<f32>; D], &[Vec<f32>; D]),
-    ) -> (f64, [f64; D], [f64; D], f64, [f64; D], Vec<u32>, f64) {
+    ) -> (
+        (f64, [f64; D], [f64; D], f64, [f64; D], Vec<u32>, f64),
+        ([f64; D], [f64; 3], [f64; 3]),
+    ) {
         let xa: [f64; D] = std::array::from_fn(|d| x[d][a] as f64);
         let va: [f64; D] = std::array::from_fn(|d| v[d][a] as f64);
         let (mf, mw) = (c.pair.m_fluid as f64, c.pair.m_bound as f64);
@@ -923,6 +918,7 @@ mod tests {
         let (mut grad, mut grad_b, mut sq, mut visc) = ([0.0; D], [0.0; D], 0.0, [0.0; D]);
         let mut list = Vec::new();
         let mut wflux = 0.0;
+        let (mut wall_visc, mut moment, mut mb) = ([0.0; D], [0.0f64; 3], [0.0f64; 3]);
         for (wall, xs, n) in [(false, x, x[0].len()), (true, xb, xb[0].len())] {
             for j in 0..n {
                 if !wall && j == a {
@@ -962,12 +958,36 @@ mod tests {
                     }
                     visc[d] -= m * pi * g;
                 }
-                if !wall {
+                if wall {
+                    let fd: [f64; D] = std::array::from_fn(|d| -m * pi * gf * dx[d]);
+                    let xw = to3(std::array::from_fn::<f64, D, _>(|d| xs[d][j] as f64));
+                    let f = to3(fd);
+                    let fk = to3(std::array::from_fn::<f64, D, _>(|d| {
+                        -MIRROR as f64 * m * gf * dx[d]
+                    }));
+                    let cross = |p: [f64; 3], q: [f64; 3]| {
+                        [
+                            p[1] * q[2] - p[2] * q[1],
+                            p[2] * q[0] - p[0] * q[2],
+                            p[0] * q[1] - p[1] * q[0],
+                        ]
+                    };
+                    for e in 0..3 {
+                        moment[e] += cross(xw, f)[e];
+                        mb[e] += cross(xw, fk)[e];
+                    }
+                    for d in 0..D {
+                        wall_visc[d] += fd[d];
+                    }
+                } else {
                     list.push(j as u32);
                 }
             }
         }
-        (density, grad, grad_b, sq, visc, list, wflux)
+        (
+            (density, grad, grad_b, sq, visc, list, wflux),
+            (wall_visc, moment, mb),
+        )
     }
 
     fn check<const D: usize, K: Kernel>() {
@@ -1033,8 +1053,9 @@ mod tests {
         bc.fill_motion(&ranges, 1, &xb, &vb);
         // The middle particle and one in the bottom row.
         let n = x[0].len();
+        let mut viscous_walls = false;
         for a in [n / 2, n1 / 2] {
-            let (density, grad, grad_b, sq, visc, list, wflux) =
+            let ((density, grad, grad_b, sq, visc, list, wflux), (wall, moment, mb)) =
                 naive(&k, &c, a, (&x, &v), (&xb, &vb));
             let own = (
                 std::array::from_fn(|d| x[d][a]),
@@ -1072,6 +1093,24 @@ mod tests {
                 }
                 let fs = gs * 0.3 * D as f64;
                 assert!((s.wflux as f64 - wflux).abs() < 1e-4 * fs, "wall flux");
+                // Moments about the lattice's corner, 3 dp away: arms of a few dp.
+                let arm = 10.0 * dp as f64;
+                for d in 0..D {
+                    assert!(
+                        (s.wall[d] as f64 - wall[d]).abs() < 1e-3 * vs,
+                        "wall viscosity {d}"
+                    );
+                }
+                for e in 0..3 {
+                    assert!(
+                        (s.moment[e] as f64 - moment[e]).abs() < 1e-3 * vs * arm,
+                        "moment {e}"
+                    );
+                    assert!(
+                        (s.mb[e] as f64 - mb[e]).abs() < 1e-4 * gs * arm,
+                        "moment per unit k {e}"
+                    );
+                }
                 assert_eq!(j, &list, "liquid neighbours");
                 assert_eq!(s.liquid as usize, list.len());
             }
@@ -1081,7 +1120,10 @@ mod tests {
             );
             assert!(grad_b.iter().any(|q| q.abs() > 0.0), "walls in reach");
             assert!(wflux.abs() > 0.0, "moving walls in reach");
+            assert!(mb.iter().any(|q| q.abs() > 0.0), "wall moments to compare");
+            viscous_walls |= wall.iter().any(|q| q.abs() > 1e-3 * vs);
         }
+        assert!(viscous_walls, "approaching walls to compare");
     }
 
     #[test]
