@@ -127,6 +127,23 @@ fn linear_forced_sway(t: f64, x_wall: f64, l: f64, h: f64, a: f64, period: f64) 
 
 #[test]
 fn faltinsen_2000_forced_sway_elevation_near_the_wall() {
+    faltinsen_2000(&[], "faltinsen2000_sway", "WCSPH");
+}
+
+/// The same comparison with the incompressible scheme (issue 5: everything validated for WCSPH holds for it).
+#[test]
+fn faltinsen_2000_forced_sway_elevation_near_the_wall_dfsph() {
+    faltinsen_2000(
+        &["solver.scheme=dfsph"],
+        "faltinsen2000_sway_dfsph",
+        "DFSPH",
+    );
+}
+
+/// Faltinsen et al. (2000), fig. 7: elevation 5 cm from the wall of a 1.73 m tank, 0.6 m deep, swayed
+/// 32 mm at 1.3 s, against linear theory (first 1.5 s) and the record (0–7 s), with `overrides` on top of
+/// dp 20 mm; draws the figure `name`.
+fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str) {
     let exp = table(&read(
         "faltinsen2000_sway/faltinsen_etal_2000_fig7_h0.6_T1.3.csv",
     ));
@@ -134,13 +151,9 @@ fn faltinsen_2000_forced_sway_elevation_near_the_wall() {
     let cfg = config::load("faltinsen2000_sway", &[]).unwrap();
     let motion = slosh_node::motion_source::build(&cfg).unwrap();
     let t_end = 7.0;
-    let (t, probe, _) = run(
-        "faltinsen2000_sway",
-        &["particle_spacing=0.02"],
-        motion.as_ref(),
-        t_end,
-        0.02,
-    );
+    let mut o = vec!["particle_spacing=0.02"];
+    o.extend_from_slice(overrides);
+    let (t, probe, _) = run("faltinsen2000_sway", &o, motion.as_ref(), t_end, 0.02);
     let eta: Vec<f64> = probe.iter().map(|p| p - 0.6).collect();
     let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
 
@@ -154,7 +167,7 @@ fn faltinsen_2000_forced_sway_elevation_near_the_wall() {
     let diff: Vec<f64> = early.iter().zip(&lin).map(|(&i, l)| eta[i] - l).collect();
     let lin_err = rms(&diff) / rms(&lin);
     eprintln!(
-        "Faltinsen 2000, first 1.5 s against linear theory: rms {:.4} m, difference {:.0} %",
+        "Faltinsen 2000 ({scheme}), first 1.5 s against linear theory: rms {:.4} m, difference {:.0} %",
         rms(&lin),
         100.0 * lin_err
     );
@@ -180,19 +193,20 @@ fn faltinsen_2000_forced_sway_elevation_near_the_wall() {
     let max_exp = meas.iter().map(|v| v.abs()).fold(0.0, f64::max);
     let max_sim = eta.iter().map(|v| v.abs()).fold(0.0, f64::max);
     eprintln!(
-        "Faltinsen 2000, 0-{t_end} s against the experiment: correlation {corr:.3}, rms ratio {ratio:.2}, peak {max_sim:.3} m vs {max_exp:.3} m"
+        "Faltinsen 2000 ({scheme}), 0-{t_end} s against the experiment: correlation {corr:.3}, rms ratio {ratio:.2}, peak {max_sim:.3} m vs {max_exp:.3} m"
     );
     let lin_all: Vec<f64> = t
         .iter()
         .map(|&x| linear_forced_sway(x, 0.05, 1.73, 0.6, 0.032, 1.3))
         .collect();
     let (te, ye): (Vec<f64>, Vec<f64>) = pts.iter().map(|r| (r[0], r[1])).unzip();
+    let label = format!("slosh ({scheme}, dp 20 mm)");
     figure(
-        "faltinsen2000_sway",
+        name,
         "Faltinsen et al. (2000): elevation 5 cm from the wall, h = 0.6 m, T = 1.3 s",
         "elevation (m)",
         vec![
-            series("slosh (WCSPH, dp 20 mm)", &t, &eta, false),
+            series(&label, &t, &eta, false),
             series("measured (Faltinsen et al. 2000, fig. 7)", &te, &ye, true),
             series("linear potential theory", &t, &lin_all, true),
         ],
@@ -203,6 +217,27 @@ fn faltinsen_2000_forced_sway_elevation_near_the_wall() {
 
 #[test]
 fn spheric10_sensor1_impacts_come_at_the_measured_times() {
+    spheric10(
+        &["solver.boundary.method=mirror"],
+        "spheric10_sensor1",
+        "WCSPH, dp 8 mm, mirror walls",
+    );
+}
+
+/// The same impacts with the incompressible scheme (its walls: the dynamic boundary's particle layers).
+#[test]
+fn spheric10_sensor1_impacts_come_at_the_measured_times_dfsph() {
+    spheric10(
+        &["solver.scheme=dfsph"],
+        "spheric10_sensor1_dfsph",
+        "DFSPH, dp 8 mm",
+    );
+}
+
+/// SPHERIC Test 10 (water, low fill), pressure sensor 1 under the measured roll law: the first three impacts
+/// come within 0.1 s of the measured ones and the slow pressure between impacts within 25 %; `overrides` on
+/// top of dp 8 mm; draws the figure `name`.
+fn spheric10(overrides: &[&str], name: &str, label: &str) {
     let rows = table(&read("spheric10_dualsphysics/CaseSloshingMotionData.dat"));
     // The measured roll law (degrees) turns the tank about its y axis: pitch in the tank frame.
     // 20 kHz: keep every 20th sample (1 kHz) for the spline.
@@ -220,17 +255,9 @@ fn spheric10_sensor1_impacts_come_at_the_measured_times() {
     ));
     exp.sort_by(|a, b| a[0].total_cmp(&b[0]));
     let t_end = 6.0;
-    let (t, _, p) = run(
-        "spheric10",
-        &[
-            "particle_spacing=0.008",
-            "motion.source=none",
-            "solver.boundary.method=mirror",
-        ],
-        &motion,
-        t_end,
-        0.002,
-    );
+    let mut o = vec!["particle_spacing=0.008", "motion.source=none"];
+    o.extend_from_slice(overrides);
+    let (t, _, p) = run("spheric10", &o, &motion, t_end, 0.002);
     let mut peaks: Vec<(f64, f64)> = vec![];
     for i in 1..p.len().saturating_sub(1) {
         if p[i] > 500.0
@@ -241,18 +268,19 @@ fn spheric10_sensor1_impacts_come_at_the_measured_times() {
             peaks.push((t[i], p[i]));
         }
     }
-    eprintln!("SPHERIC 10 simulated peaks over 500 Pa (t, Pa): {peaks:.3?}");
+    eprintln!("SPHERIC 10 ({label}) simulated peaks over 500 Pa (t, Pa): {peaks:.3?}");
     let (te, pe): (Vec<f64>, Vec<f64>) = exp
         .iter()
         .filter(|r| r[0] <= t_end)
         .map(|r| (r[0], r[1]))
         .unzip();
+    let legend = format!("slosh ({label})");
     figure(
-        "spheric10_sensor1",
+        name,
         "SPHERIC Test 10 (water, low fill): pressure at sensor 1",
         "pressure (Pa)",
         vec![
-            series("slosh (WCSPH, dp 8 mm, mirror walls)", &t, &p, false),
+            series(&legend, &t, &p, false),
             series("measured", &te, &pe, true),
         ],
     );
@@ -270,12 +298,31 @@ fn spheric10_sensor1_impacts_come_at_the_measured_times() {
             .filter(|r| (r[0] - t_peak).abs() < 0.3)
             .map(|r| r[1])
             .fold(f64::MIN, f64::max);
-        eprintln!("SPHERIC 10 impact near {t_peak} s: simulated peak {ps:.0} Pa at {ts:.3} s, measured {pe:.0} Pa");
+        eprintln!("SPHERIC 10 ({label}) impact near {t_peak} s: simulated peak {ps:.0} Pa at {ts:.3} s, measured {pe:.0} Pa");
         assert!(
             (ts - t_peak).abs() < 0.1,
             "simulated impact at {ts} s, measured at {t_peak} s"
         );
         // Magnitudes are printed, not asserted: repetitions scatter by tens of percent, and single-sample
         // WCSPH spikes here reach 5-11x the measured peaks (a known gap on issue 2).
+    }
+    // Between impacts the pressure is the slow part of the flow, which the record resolves well: the
+    // sensor's mean over the rise before the first impact and over the run-up after it.
+    let mean_in = |ts: &[f64], ys: &[f64], lo: f64, hi: f64| {
+        let v: Vec<f64> = ts
+            .iter()
+            .zip(ys)
+            .filter(|(x, _)| **x >= lo && **x <= hi)
+            .map(|(_, y)| *y)
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    for (lo, hi) in [(0.6, 1.2), (2.45, 2.85)] {
+        let (ms, me) = (mean_in(&t, &p, lo, hi), mean_in(&te, &pe, lo, hi));
+        eprintln!("SPHERIC 10 ({label}) mean pressure {lo}-{hi} s: simulated {ms:.0} Pa, measured {me:.0} Pa");
+        assert!(
+            (ms - me).abs() < 0.25 * me,
+            "mean pressure {lo}-{hi} s: simulated {ms} Pa, measured {me} Pa"
+        );
     }
 }
