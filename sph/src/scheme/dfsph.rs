@@ -462,6 +462,7 @@ enum Mode {
 /// which keeps the Jacobi iteration stable and never sucks liquid together). Returns the summed error
 /// (density units).
 #[allow(clippy::too_many_arguments)]
+// Kept out of line (called once per chunk): the passes show by name in profiles.
 #[inline(never)]
 fn error_chunk<const D: usize>(
     c: &Coefficients,
@@ -514,6 +515,7 @@ fn error_chunk<const D: usize>(
 }
 
 /// Pass 3 for one chunk: the velocity change from k (the walls push back with the particle's own k).
+// Kept out of line, as `error_chunk`.
 #[inline(never)]
 fn update_chunk<const D: usize>(
     c: &Coefficients,
