@@ -171,25 +171,26 @@ pub fn counting_sort(
     starts: &mut Vec<u32>,
     dest: &mut Vec<u32>,
 ) -> usize {
+    // Counts go two slots up, so that after the prefix sum starts[s + 1] is where cell s begins: used as the
+    // cell's running cursor, it ends where cell s + 1 begins, leaving starts[s] = begin(s) for every s with
+    // no second array.
     starts.clear();
-    starts.resize(n_cells + 2, 0);
+    starts.resize(n_cells + 3, 0);
     for &c in cells {
         let slot = if c == OUTSIDE { n_cells } else { c as usize };
-        starts[slot + 1] += 1;
+        starts[slot + 2] += 1;
     }
-    for i in 0..=n_cells {
+    for i in 0..n_cells + 2 {
         starts[i + 1] += starts[i];
     }
     dest.clear();
     dest.resize(cells.len(), 0);
-    // Running cursor per cell, reusing a second pass over a copy of the offsets.
-    let inside = starts[n_cells] as usize;
-    let mut cursor: Vec<u32> = starts[..=n_cells].to_vec();
     for (i, &c) in cells.iter().enumerate() {
         let slot = if c == OUTSIDE { n_cells } else { c as usize };
-        dest[i] = cursor[slot];
-        cursor[slot] += 1;
+        dest[i] = starts[slot + 1];
+        starts[slot + 1] += 1;
     }
+    let inside = starts[n_cells] as usize;
     starts.truncate(n_cells + 1);
     inside
 }

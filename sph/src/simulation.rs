@@ -785,10 +785,14 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     /// Steps until the simulation time reaches `t_end`.
     pub fn advance_to(&mut self, motion: &dyn TankMotion, t_end: f64) -> Result<(), SimError> {
-        while self.time < t_end {
-            self.step(motion)?;
-        }
-        Ok(())
+        // One entry into rayon's pool for all the steps (see `step`): entering from outside hands a job to a
+        // pool thread and wakes it, and rayon's queue allocates a block every 63 such entries.
+        rayon::scope(|_| {
+            while self.time < t_end {
+                self.step_here(motion)?;
+            }
+            Ok(())
+        })
     }
 
     /// Observables of the current state (evaluates the rates of the current state if the last step did not).
