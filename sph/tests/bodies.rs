@@ -7,7 +7,8 @@ use sph::motion::AtRest;
 use sph::params::*;
 use sph::Solver;
 
-const G: f64 = 9.81;
+mod common;
+use common::{probe, tank2d, G};
 const RHO: f64 = 1000.0;
 const DP: f64 = 0.005;
 /// The basin's water depth and the box's outer width (square section), m.
@@ -16,30 +17,11 @@ const B: f64 = 0.2;
 const WALL: f64 = 0.015;
 
 fn basin(bodies: Vec<BodySpec>) -> SimParams {
-    SimParams {
-        dimension: 2,
-        tank: TankSpec {
-            length: 0.8,
-            breadth: 1.0,
-            height: 0.4,
-        },
-        fill: FillSpec {
-            height: DEPTH,
-            length: 0.0,
-        },
-        particle_spacing: DP,
-        fluid: FluidSpec::default(),
-        gravity: G,
-        solver: SolverSpec::default(),
-        probes: vec![ProbeSpec {
-            name: "far".into(),
-            x: -0.3,
-            y: 0.0,
-        }],
-        pressure_sensors: vec![],
-        bodies,
-        wave_maker: None,
-    }
+    let mut p = tank2d(0.8, 0.4, DEPTH, DP);
+    p.tank.breadth = 1.0;
+    p.probes = vec![probe("far", -0.3)];
+    p.bodies = bodies;
+    p
 }
 
 /// A closed B × B box per metre of breadth floating at `draught`, centre of gravity `kg` above its bottom.

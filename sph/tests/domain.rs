@@ -10,49 +10,29 @@ use sph::params::*;
 use sph::Simulation;
 use std::sync::Arc;
 
+mod common;
+use common::{probe, tank2d};
+
 fn case(scheme: Scheme, method: BoundaryMethod) -> SimParams {
-    let mut solver = SolverSpec {
-        scheme,
-        ..Default::default()
-    };
-    solver.boundary.method = method;
-    SimParams {
-        dimension: 2,
-        tank: TankSpec {
-            length: 0.8,
-            breadth: 0.25,
-            height: 0.6,
-        },
-        fill: FillSpec {
-            height: 0.25,
-            length: 0.0,
-        },
-        particle_spacing: 0.02,
-        fluid: FluidSpec::default(),
-        gravity: 9.81,
-        solver,
-        probes: [-0.375, -0.1, 0.0, 0.2]
-            .iter()
-            .enumerate()
-            .map(|(i, &x)| ProbeSpec {
-                name: format!("p{i}"),
-                x,
-                y: 0.0,
-            })
-            .collect(),
-        pressure_sensors: [(-0.4, 0.1), (0.0, 0.0), (0.4, 0.05)]
-            .iter()
-            .enumerate()
-            .map(|(i, &(x, z))| SensorSpec {
-                name: format!("s{i}"),
-                x,
-                y: 0.0,
-                z,
-            })
-            .collect(),
-        bodies: vec![],
-        wave_maker: None,
-    }
+    let mut p = tank2d(0.8, 0.6, 0.25, 0.02);
+    p.solver.scheme = scheme;
+    p.solver.boundary.method = method;
+    p.probes = [-0.375, -0.1, 0.0, 0.2]
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| probe(&format!("p{i}"), x))
+        .collect();
+    p.pressure_sensors = [(-0.4, 0.1), (0.0, 0.0), (0.4, 0.05)]
+        .iter()
+        .enumerate()
+        .map(|(i, &(x, z))| SensorSpec {
+            name: format!("s{i}"),
+            x,
+            y: 0.0,
+            z,
+        })
+        .collect();
+    p
 }
 
 fn motion() -> RegularMotion {

@@ -7,6 +7,9 @@ use sph::params::*;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+mod common;
+use common::{probe, tank2d};
+
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
 
 struct Counting;
@@ -36,36 +39,12 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static COUNTING: Counting = Counting;
 
-/// The seed tank in 2D (0.8 m, 0.39 m fill) at dp 2 cm, swayed 2 cm at 1.2 s and pitched 3° at 1.5 s.
+/// The seed tank in 2D (0.8 m, 0.39 m fill) at dp 2 cm, with a probe by the left wall.
 fn seed_tank(scheme: Scheme) -> SimParams {
-    let solver = SolverSpec {
-        scheme,
-        ..Default::default()
-    };
-    SimParams {
-        dimension: 2,
-        tank: TankSpec {
-            length: 0.8,
-            breadth: 0.25,
-            height: 0.6,
-        },
-        fill: FillSpec {
-            height: 0.39,
-            length: 0.0,
-        },
-        particle_spacing: 0.02,
-        fluid: FluidSpec::default(),
-        gravity: 9.81,
-        solver,
-        probes: vec![ProbeSpec {
-            name: "wall".into(),
-            x: -0.37,
-            y: 0.0,
-        }],
-        pressure_sensors: vec![],
-        bodies: vec![],
-        wave_maker: None,
-    }
+    let mut p = tank2d(0.8, 0.6, 0.39, 0.02);
+    p.solver.scheme = scheme;
+    p.probes = vec![probe("wall", -0.37)];
+    p
 }
 
 #[test]

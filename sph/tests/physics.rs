@@ -10,38 +10,8 @@ use sph::motion::{AtRest, Dof6, Dof6Motion, RegularDof, RegularMotion, TankMotio
 use sph::params::*;
 use sph::Solver;
 
-const G: f64 = 9.81;
-
-fn tank2d(length: f64, height: f64, fill: f64, dp: f64) -> SimParams {
-    SimParams {
-        dimension: 2,
-        tank: TankSpec {
-            length,
-            breadth: 0.25,
-            height,
-        },
-        fill: FillSpec {
-            height: fill,
-            length: 0.0,
-        },
-        particle_spacing: dp,
-        fluid: FluidSpec::default(),
-        gravity: G,
-        solver: SolverSpec::default(),
-        probes: vec![],
-        pressure_sensors: vec![],
-        bodies: vec![],
-        wave_maker: None,
-    }
-}
-
-fn probe(name: &str, x: f64) -> ProbeSpec {
-    ProbeSpec {
-        name: name.into(),
-        x,
-        y: 0.0,
-    }
-}
+mod common;
+use common::{probe, tank2d, G};
 
 /// Runs to `t_end`, averaging observations taken every `every` seconds after `t_avg`.
 fn run_and_average(
