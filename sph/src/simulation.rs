@@ -539,22 +539,28 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     /// After a divergence-free step of `dt` from t: the liquid's force on the bodies over the step (from the
     /// positions it was solved at and each particle's total k), and the bodies moved with it.
     fn move_bodies_dfsph(&mut self, frame: &FrameTerms, t: f64, dt: f64) {
-        let f = &self.fluid;
-        coupling::liquid_forces_dfsph(
-            &self.kernel,
-            &self.dcoef,
-            &self.grid,
-            f,
-            &self.bound,
-            |a| (f.kappa[a] + f.kappa_div[a]) as f32,
-            &self.bodies.slots,
-            &mut self.bodies.forces,
-        );
-        self.accelerate_bodies(frame, true);
+        self.bodies_feel_the_solve(frame);
         for b in self.bodies.list.iter_mut() {
             b.advance(t, dt);
         }
         self.contain_bodies();
+    }
+
+    /// The liquid's force on the bodies from the last divergence-free solve (each liquid particle's total k,
+    /// at the positions it was solved at), and the bodies' accelerations from it.
+    fn bodies_feel_the_solve(&mut self, frame: &FrameTerms) {
+        let w = &self.dwork;
+        coupling::liquid_forces_dfsph(
+            &self.kernel,
+            &self.dcoef,
+            &self.grid,
+            &self.fluid,
+            &self.bound,
+            |a| w.total_k(a),
+            &self.bodies.slots,
+            &mut self.bodies.forces,
+        );
+        self.accelerate_bodies(frame, true);
     }
 
     /// Bodies rest on the tank's walls: their particles stay a spacing inside the inner faces.
@@ -805,18 +811,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 if !self.bodies.is_empty() {
                     // The liquid's force on the bodies in this state (no step made it yet).
                     let frame = self.frame(motion, self.time);
-                    let (f, w) = (&self.fluid, &self.dwork);
-                    coupling::liquid_forces_dfsph(
-                        &self.kernel,
-                        &self.dcoef,
-                        &self.grid,
-                        f,
-                        &self.bound,
-                        |a| w.total_k(a),
-                        &self.bodies.slots,
-                        &mut self.bodies.forces,
-                    );
-                    self.accelerate_bodies(&frame, true);
+                    self.bodies_feel_the_solve(&frame);
                 }
             }
             self.rebin(self.time, false)?;
