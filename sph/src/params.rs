@@ -66,6 +66,11 @@ pub struct DfsphSpec {
     /// longer again (× 1.1, up to `dt_max` and the CFL limit). A step whose constant-density solve stops at
     /// `max_iterations` above the tolerance is solved again at half the step. 0 turns both off.
     pub target_iterations: u32,
+    /// Share β of the hydrostatic pressure (per column of the liquid, below its highest particle) that the
+    /// constant-density solve carries over whole from the last step; the rest of the last pressure is
+    /// halved (`sph::scheme::warm_start`). 0: half the whole last pressure (Bender & Koschier 2017), as
+    /// always with moving bodies (floating bodies, a wave maker).
+    pub hydrostatic_warm_start: f64,
 }
 
 impl Default for DfsphSpec {
@@ -79,6 +84,7 @@ impl Default for DfsphSpec {
             max_iterations: 100,
             divergence_solve: true,
             target_iterations: 20,
+            hydrostatic_warm_start: 0.95,
         }
     }
 }
@@ -442,6 +448,15 @@ impl SimParams {
                     format!(
                         "must be at most max_iterations ({}), got {}; 0 turns the control off",
                         d.max_iterations, d.target_iterations
+                    ),
+                ));
+            }
+            if !(0.0..=1.0).contains(&d.hydrostatic_warm_start) {
+                return Err(err(
+                    "solver.dfsph.hydrostatic_warm_start",
+                    format!(
+                        "must be in [0, 1] (0: half the last pressure), got {}",
+                        d.hydrostatic_warm_start
                     ),
                 ));
             }

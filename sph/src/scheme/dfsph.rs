@@ -11,7 +11,8 @@
 //!    0.8× the last step after one that needed more than `target_iterations`, growing back 1.1× a step);
 //! 3. makes the velocity field divergence-free (the divergence solver), then predicts v* = v + dt·a and
 //!    corrects it until the mean predicted density error is below the tolerance (the constant-density
-//!    solver). Both start from half the last step's pressure (warm start) and iterate
+//!    solver). The divergence solve starts from half its last pressure, the constant-density solve from the
+//!    hydrostatic part of its last pressure whole and the rest halved (`warm_start`); both iterate
 //!    `k_i = max(error_i, 0) · α_i / dt^n`,
 //!    `Δv_i = −dt Σ_j m_j (k_i + k_j) ∇W_ij − dt Σ_b m_b k_i ∇W_ib` (k plays p/ρ², so p = ρ² Σ k);
 //!    A constant-density solve that stops at `max_iterations` above the tolerance is done again, with the
@@ -27,12 +28,13 @@
 //! results do not depend on the number of threads.
 
 use super::candidates::{lane_sum, wide_lanes, Candidates, LANES};
+use super::warm_start::{Columns, Setting};
 use super::{FrameTerms, PassTotals, Ranks, CHUNK};
 use crate::domain::Op;
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DfsphSpec;
-use crate::particles::{Boundary, Fluid, HALO};
+use crate::particles::{Boundary, Fluid, HALO, NOT_BODY};
 use crate::tank::{cross, from3, to3};
 use rayon::prelude::*;
 
@@ -40,11 +42,12 @@ use rayon::prelude::*;
 /// boundary term, as SPlisHSPlasH's DFSPH; full pressure mirroring, 2, makes wall particles jitter here).
 pub const MIRROR: f32 = 1.0;
 
-/// Share of the last step's pressure a solve starts from. Each iteration only adds pressure where the
-/// liquid is compressed (a monotone update that keeps the Jacobi iteration stable and never sucks liquid
-/// together), so a fuller warm start could never be undone where the flow relaxes. (Measured: a projected
-/// two-sided update from the full pressure with Chebyshev acceleration needs 2–3× fewer iterations, but its
-/// pressure field is noisy enough to shift the first sloshing mode's period by 5 %.)
+/// Share of the last step's pressure the divergence solve starts from. Each iteration only adds pressure
+/// where the liquid is compressed (a monotone update that keeps the Jacobi iteration stable and never sucks
+/// liquid together), so a fuller warm start could never be undone where the flow relaxes. (Measured: a
+/// projected two-sided update from the full pressure with Chebyshev acceleration needs 2–3× fewer iterations,
+/// but its pressure field is noisy enough to shift the first sloshing mode's period by 5 %.) The
+/// constant-density solve carries the hydrostatic part of its last pressure whole (`warm_start`).
 const WARM: f32 = 0.5;
 
 /// Density errors are summed in units of 2^-20 kg/m³, as integers: the sum (and so the iteration count)
@@ -120,6 +123,9 @@ pub struct Workspace<const D: usize> {
     /// Longest step something else (moving bodies) allows (0: none).
     dt_bound: f64,
     partials: Vec<Partial>,
+    /// Where the constant-density solve starts (per particle), and the columns that make it.
+    start: Vec<f64>,
+    columns: Columns,
 }
 
 /// What one step (or a priming solve) did.
@@ -674,7 +680,7 @@ impl<const D: usize> Workspace<D> {
         merged(partials).totals
     }
 
-    /// Starts from half the pressure `warm` of the last step (p/ρ², applied as a first velocity update), then
+    /// Starts from `share` × `warm` (p/ρ², applied as a first velocity update), then
     /// iterates passes 2 and 3 until the mean error is below `tol` (at least `min` iterations, at most
     /// `max`). Returns (iterations, final error, wall totals); `ksum` holds the solve's total k. Across
     /// `ranks`, the halo copies take their owners' k and velocities after every pass and the error is the
@@ -687,12 +693,17 @@ impl<const D: usize> Workspace<D> {
         dt: f32,
         tol: f64,
         (min, max): (u32, u32),
-        warm: &[f64],
+        (warm, share): (&[f64], f32),
         mut ranks: Option<&mut (dyn Ranks<D> + 'r)>,
     ) -> (u32, f64, PassTotals) {
         self.ksum.iter_mut().for_each(|k| *k = 0.0);
         for (k, w) in self.k.iter_mut().zip(warm) {
-            *k = WARM * *w as f32;
+            *k = share * *w as f32;
+        }
+        if let Some(r) = ranks.as_deref_mut() {
+            // A halo copy's start may depend on particles beyond the halo (the hydrostatic warm start's
+            // column): its owner's.
+            r.sync_scalar(&mut self.k);
         }
         self.update(c, dt);
         if let Some(r) = ranks.as_deref_mut() {
@@ -789,6 +800,27 @@ pub fn step<'r, const D: usize, K: Kernel>(
     }
     // Shortest step a solve that does not converge is retried at.
     let dt_floor = dt / 16.0;
+    // Where the constant-density solve starts (the same for every try of the step).
+    let mut start = std::mem::take(&mut work.start);
+    // Not with moving bodies (floating bodies, a wave maker): a body's motion must change the pressure
+    // around it within the step, and the solve can only add pressure (measured: a floating box's roll grows
+    // instead of decaying, its heave period leaves the band of added masses).
+    let moving_bodies = bound.tag.iter().any(|&t| t != NOT_BODY);
+    work.columns.warm_start(
+        grid,
+        fluid,
+        Setting {
+            dp,
+            rho_rest: c.rho_rest,
+            gz: -frame.g[2],
+            beta: if moving_bodies {
+                0.0
+            } else {
+                spec.hydrostatic_warm_start
+            },
+        },
+        &mut start,
+    );
     loop {
         report.totals = built.totals;
         let dtf = dt as f32;
@@ -804,7 +836,7 @@ pub fn step<'r, const D: usize, K: Kernel>(
                 dtf,
                 spec.max_divergence_error,
                 (1, spec.max_iterations),
-                &fluid.kappa_div,
+                (&fluid.kappa_div, WARM),
                 ranks.as_deref_mut(),
             );
             report.divergence_iterations += it;
@@ -826,7 +858,7 @@ pub fn step<'r, const D: usize, K: Kernel>(
             dtf,
             spec.max_density_error,
             (spec.min_iterations, spec.max_iterations),
-            &fluid.kappa,
+            (&start, 1.0),
             ranks.as_deref_mut(),
         );
         report.density_iterations += it;
@@ -856,6 +888,7 @@ pub fn step<'r, const D: usize, K: Kernel>(
         }
         break;
     }
+    work.start = start;
     report.dt = dt;
     if work.vel.iter().any(|v| !v.iter().all(|x| x.is_finite())) {
         report.totals.non_finite = true;

@@ -3,6 +3,7 @@
 
 pub mod candidates;
 pub mod dfsph;
+pub mod warm_start;
 pub mod wcsph;
 
 /// Particles per parallel work item of every scheme's passes (fixed, so reductions do not depend on the
