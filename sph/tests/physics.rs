@@ -578,7 +578,7 @@ fn dfsph_first_sloshing_mode_has_the_linear_frequency() {
         noise < 0.35 * signal,
         "wall force noise {noise} N rms against {signal} N of the running mean"
     );
-    // The periods come out 0.2 % (probe) and 2.8 % (force) short: a known gap (WCSPH: within 2 %). Held
+    // The periods come out 1.6 % (probe) and 2.6 % (force) short: a known gap (WCSPH: within 2 %). Held
     // within 3 % and 6 % here so that it does not get worse unnoticed.
     assert!(
         (t_probe - expect).abs() < 0.03 * expect,
