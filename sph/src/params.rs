@@ -69,7 +69,7 @@ pub struct DfsphSpec {
     /// Share β of the hydrostatic pressure (per column of the liquid, below its highest particle) that the
     /// constant-density solve carries over whole from the last step; the rest of the last pressure is
     /// halved (`sph::scheme::warm_start`). 0: half the whole last pressure (Bender & Koschier 2017), as
-    /// always with moving bodies (floating bodies, a wave maker).
+    /// always with bodies (floating bodies, fixed or not, a wave maker) and with `smoothing_ratio` < 1.
     pub hydrostatic_warm_start: f64,
 }
 

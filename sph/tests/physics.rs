@@ -549,7 +549,6 @@ fn dfsph_first_sloshing_mode_has_the_linear_frequency() {
         p.solver.scheme = Scheme::Dfsph;
         p.particle_spacing = 0.01;
     });
-
     // The wall force carries the solver's step-to-step pressure noise: its period is read from the 0.3 s
     // running mean.
     let smooth: Vec<f64> = (0..fx.len())

@@ -48,7 +48,7 @@ pub const MIRROR: f32 = 1.0;
 /// projected two-sided update from the full pressure with Chebyshev acceleration needs 2–3× fewer iterations,
 /// but its pressure field is noisy enough to shift the first sloshing mode's period by 5 %.) The
 /// constant-density solve carries the hydrostatic part of its last pressure whole (`warm_start`).
-const WARM: f32 = 0.5;
+pub(crate) const WARM: f32 = 0.5;
 
 /// Density errors are summed in units of 2^-20 kg/m³, as integers: the sum (and so the iteration count)
 /// does not depend on the order of the additions, which differs between one process and several ranks.
@@ -700,9 +700,9 @@ impl<const D: usize> Workspace<D> {
         for (k, w) in self.k.iter_mut().zip(warm) {
             *k = share * *w as f32;
         }
-        if let Some(r) = ranks.as_deref_mut() {
+        if let (Some(r), Mode::Density) = (ranks.as_deref_mut(), mode) {
             // A halo copy's start may depend on particles beyond the halo (the hydrostatic warm start's
-            // column): its owner's.
+            // columns): its owner's.
             r.sync_scalar(&mut self.k);
         }
         self.update(c, dt);
@@ -802,10 +802,10 @@ pub fn step<'r, const D: usize, K: Kernel>(
     let dt_floor = dt / 16.0;
     // Where the constant-density solve starts (the same for every try of the step).
     let mut start = std::mem::take(&mut work.start);
-    // Not with moving bodies (floating bodies, a wave maker): a body's motion must change the pressure
+    // Not with bodies (floating bodies, fixed or not, a wave maker): a body's motion must change the pressure
     // around it within the step, and the solve can only add pressure (measured: a floating box's roll grows
     // instead of decaying, its heave period leaves the band of added masses).
-    let moving_bodies = bound.tag.iter().any(|&t| t != NOT_BODY);
+    let bodies = bound.tag.iter().any(|&t| t != NOT_BODY);
     work.columns.warm_start(
         grid,
         fluid,
@@ -813,7 +813,7 @@ pub fn step<'r, const D: usize, K: Kernel>(
             dp,
             rho_rest: c.rho_rest,
             gz: -frame.g[2],
-            beta: if moving_bodies {
+            beta: if bodies || !Setting::applies(grid.cell_size(), dp) {
                 0.0
             } else {
                 spec.hydrostatic_warm_start
