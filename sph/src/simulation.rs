@@ -291,6 +291,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             // Bodies start from rest with forces the liquid has not balanced yet (a hole, a kick): the
             // incompressible scheme's steps start a tenth of their longest and grow as the solves allow.
             sim.dwork.start_at(0.1 * sim.params.solver.dfsph.dt_max);
+            sim.dwork.plain_warm_start();
         }
         Ok(sim)
     }

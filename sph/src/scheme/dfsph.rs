@@ -34,7 +34,7 @@ use crate::domain::Op;
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DfsphSpec;
-use crate::particles::{Boundary, Fluid, HALO, NOT_BODY};
+use crate::particles::{Boundary, Fluid, HALO};
 use crate::tank::{cross, from3, to3};
 use rayon::prelude::*;
 
@@ -126,6 +126,9 @@ pub struct Workspace<const D: usize> {
     /// Where the constant-density solve starts (per particle), and the columns that make it.
     start: Vec<f64>,
     columns: Columns,
+    /// Start the constant-density solve from half the last pressure, not from its hydrostatic part
+    /// ([`Workspace::plain_warm_start`]).
+    plain_warm_start: bool,
 }
 
 /// What one step (or a priming solve) did.
@@ -572,6 +575,14 @@ impl<const D: usize> Workspace<D> {
         self.dt_cap = dt;
     }
 
+    /// Starts every constant-density solve from half the last pressure, for a case with bodies (floating
+    /// bodies, fixed or not, a wave maker): a body's motion must change the pressure around it within the
+    /// step, and the solve can only add pressure (measured with the hydrostatic warm start: a floating
+    /// box's roll grows instead of decaying, its heave period leaves the band of added masses).
+    pub fn plain_warm_start(&mut self) {
+        self.plain_warm_start = true;
+    }
+
     /// Bounds the next steps by `dt` (∞: no bound), beside the flow's own limits and the iteration control.
     pub fn bound(&mut self, dt: f64) {
         self.dt_bound = if dt.is_finite() { dt } else { 0.0 };
@@ -802,10 +813,6 @@ pub fn step<'r, const D: usize, K: Kernel>(
     let dt_floor = dt / 16.0;
     // Where the constant-density solve starts (the same for every try of the step).
     let mut start = std::mem::take(&mut work.start);
-    // Not with bodies (floating bodies, fixed or not, a wave maker): a body's motion must change the pressure
-    // around it within the step, and the solve can only add pressure (measured: a floating box's roll grows
-    // instead of decaying, its heave period leaves the band of added masses).
-    let bodies = bound.tag.iter().any(|&t| t != NOT_BODY);
     work.columns.warm_start(
         grid,
         fluid,
@@ -813,7 +820,7 @@ pub fn step<'r, const D: usize, K: Kernel>(
             dp,
             rho_rest: c.rho_rest,
             gz: -frame.g[2],
-            beta: if bodies || !Setting::applies(grid.cell_size(), dp) {
+            beta: if work.plain_warm_start || !Setting::applies(grid.cell_size(), dp) {
                 0.0
             } else {
                 spec.hydrostatic_warm_start

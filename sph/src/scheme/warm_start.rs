@@ -189,21 +189,34 @@ mod tests {
     const RHO: f32 = 1000.0;
     const G: f32 = 9.81;
 
-    /// Two columns of liquid 5 particles deep (2D), with last pressures `k(x, depth)`.
-    fn liquid(k: impl Fn(f64, f64) -> f64) -> (Grid<2>, Fluid<2>) {
-        let grid = Grid::new([-1.0, -1.0], [1.0, 1.0], 0.13);
-        let pts: Vec<[f64; 2]> = [0.05, 0.35]
+    /// Two columns of liquid 5 particles deep, at 0.05 and 0.35 along `axis` (0 at 0.05 along the other
+    /// horizontal axis in 3D), with last pressures `k(position along axis, depth)`.
+    fn columns<const D: usize>(axis: usize, k: impl Fn(f64, f64) -> f64) -> (Grid<D>, Fluid<D>) {
+        let grid = Grid::new([-1.0; D], [1.0; D], 0.13);
+        let pts: Vec<[f64; D]> = [0.05, 0.35]
             .iter()
-            .flat_map(|&x| (0..5).map(move |i| [x, 0.05 + i as f64 * DP]))
+            .flat_map(|&s| {
+                (0..5).map(move |i| {
+                    let mut p = [0.05; D];
+                    p[axis] = s;
+                    p[D - 1] = 0.05 + i as f64 * DP;
+                    p
+                })
+            })
             .collect();
         let mut f = Fluid::new(&pts, |_| RHO as f64);
-        for d in 0..2 {
+        for d in 0..D {
             f.x[d] = f.pos[d].iter().map(|v| *v as f32).collect();
         }
         for (a, p) in pts.iter().enumerate() {
-            f.kappa[a] = k(p[0], 0.45 - p[1]);
+            f.kappa[a] = k(p[axis], 0.45 - p[D - 1]);
         }
         (grid, f)
+    }
+
+    /// [`columns`] in 2D, along x.
+    fn liquid(k: impl Fn(f64, f64) -> f64) -> (Grid<2>, Fluid<2>) {
+        columns(0, k)
     }
 
     fn setting(gz: f32, beta: f64) -> Setting {
@@ -219,7 +232,7 @@ mod tests {
         G as f64 * depth / RHO as f64
     }
 
-    fn starts(f: &Fluid<2>, grid: &Grid<2>, beta: f64) -> Vec<f64> {
+    fn starts<const D: usize>(f: &Fluid<D>, grid: &Grid<D>, beta: f64) -> Vec<f64> {
         let mut out = Vec::new();
         Columns::default().warm_start(grid, f, setting(G, beta), &mut out);
         assert_eq!(out.len(), f.len());
@@ -269,24 +282,11 @@ mod tests {
     #[test]
     fn in_3d_the_columns_stand_on_x_and_y() {
         // Two columns side by side in y, one at hydrostatic, one at twice: each keeps its own start.
-        let grid = Grid::new([-1.0; 3], [1.0; 3], 0.13);
-        let pts: Vec<[f64; 3]> = [0.05, 0.35]
-            .iter()
-            .flat_map(|&y| (0..5).map(move |i| [0.05, y, 0.05 + i as f64 * DP]))
-            .collect();
-        let mut f = Fluid::new(&pts, |_| RHO as f64);
-        for d in 0..3 {
-            f.x[d] = f.pos[d].iter().map(|v| *v as f32).collect();
-        }
-        for (a, p) in pts.iter().enumerate() {
-            let h = hydro(0.45 - p[2]);
-            f.kappa[a] = if p[1] < 0.2 { h } else { 2.0 * h };
-        }
-        let mut out = Vec::new();
-        Columns::default().warm_start(&grid, &f, setting(G, 0.95), &mut out);
-        for (a, p) in pts.iter().enumerate() {
-            let h = hydro(0.45 - p[2]);
-            let expect = if p[1] < 0.2 {
+        let (grid, f) = columns::<3>(1, |y, d| if y < 0.2 { hydro(d) } else { 2.0 * hydro(d) });
+        let out = starts(&f, &grid, 0.95);
+        for a in 0..f.len() {
+            let h = hydro(0.45 - f.pos[2][a]);
+            let expect = if f.pos[1][a] < 0.2 {
                 0.975 * h
             } else {
                 0.95 * h + 0.5 * 1.05 * h
