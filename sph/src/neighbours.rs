@@ -106,13 +106,13 @@ impl<const D: usize> Grid<D> {
         c
     }
 
-    /// Index ranges (into the sorted particle arrays described by `starts`) of the cells around the cell at
-    /// integer coordinates `c`. Returns how many of `out` are filled.
+    /// Index ranges (into the sorted particle arrays described by `starts`) of the cells around the `width`
+    /// cells of a row starting at integer coordinates `c`. Returns how many of `out` are filled.
     #[inline]
-    fn ranges_at(&self, c: [i64; D], starts: &[u32], out: &mut Ranges) -> usize {
+    fn ranges_at(&self, c: [i64; D], width: i64, starts: &[u32], out: &mut Ranges) -> usize {
         let nx = self.dims[0] as i64;
         let x0 = (c[0] - REACH).max(0);
-        let x1 = (c[0] + REACH).min(nx - 1);
+        let x1 = (c[0] + width - 1 + REACH).min(nx - 1);
         if x0 > x1 {
             return 0;
         }
@@ -146,7 +146,22 @@ impl<const D: usize> Grid<D> {
     /// Neighbour ranges of the particles of `cell`.
     #[inline]
     pub fn ranges(&self, cell: u32, starts: &[u32], out: &mut Ranges) -> usize {
-        self.ranges_at(self.coords(cell), starts, out)
+        self.ranges_at(self.coords(cell), 1, starts, out)
+    }
+
+    /// The end (exclusive) of the run of at most `width` cells along x that starts at `cell` and stays in
+    /// its row: the cells of a [`Self::run_ranges`].
+    #[inline]
+    pub fn run_end(&self, cell: u32, width: u32) -> u32 {
+        let nx = self.dims[0] as u32;
+        (cell + width).min((cell / nx + 1) * nx)
+    }
+
+    /// Neighbour ranges shared by the particles of the cells `cell..end` of one row ([`Self::run_end`]): the
+    /// rows of cells around the run, each one contiguous range, so one copy of candidates serves them all.
+    #[inline]
+    pub fn run_ranges(&self, cell: u32, end: u32, starts: &[u32], out: &mut Ranges) -> usize {
+        self.ranges_at(self.coords(cell), (end - cell) as i64, starts, out)
     }
 
     /// Neighbour ranges of an arbitrary point (probes, sensors); points off the grid see what is in reach.
@@ -158,7 +173,7 @@ impl<const D: usize> Grid<D> {
                 return 0;
             }
         }
-        self.ranges_at(c, starts, out)
+        self.ranges_at(c, 1, starts, out)
     }
 }
 
@@ -327,6 +342,45 @@ mod tests {
     #[test]
     fn grid_finds_exactly_the_naive_pairs_3d() {
         check::<3>();
+    }
+
+    fn run_ranges_are_the_union_of_the_cells_ranges<const D: usize>() {
+        let grid = Grid::<D>::new([0.0; D], [1.0; D], 0.1);
+        let pos = random_points::<D>(if D == 2 { 400 } else { 4000 }, 7, 0.0, 0.999);
+        let cells: Vec<u32> = pos.iter().map(|p| grid.cell_of(*p)).collect();
+        let (mut starts, mut dest) = (Vec::new(), Vec::new());
+        counting_sort(grid.n_cells(), &cells, &mut starts, &mut dest);
+        let indices = |ranges: &Ranges, n: usize| -> Vec<u32> {
+            ranges[..n].iter().flat_map(|&(a, b)| a..b).collect()
+        };
+        let mut ranges = NO_RANGES;
+        for cell in 0..grid.n_cells() as u32 {
+            for width in [1, 3, 4] {
+                let end = grid.run_end(cell, width);
+                assert!(end > cell && end - cell <= width);
+                assert_eq!((end - 1) / 10, cell / 10, "a run stays in its row");
+                let n = grid.run_ranges(cell, end, &starts, &mut ranges);
+                let run = indices(&ranges, n);
+                let mut union: Vec<u32> = (cell..end)
+                    .flat_map(|c| {
+                        let n = grid.ranges(c, &starts, &mut ranges);
+                        indices(&ranges, n)
+                    })
+                    .collect();
+                union.sort_unstable();
+                union.dedup();
+                let mut run = run;
+                run.sort_unstable();
+                // Equal to the deduplicated union: every particle once.
+                assert_eq!(run, union);
+            }
+        }
+    }
+
+    #[test]
+    fn run_ranges_are_the_union_of_the_cells_ranges_2d_and_3d() {
+        run_ranges_are_the_union_of_the_cells_ranges::<2>();
+        run_ranges_are_the_union_of_the_cells_ranges::<3>();
     }
 
     #[test]

@@ -16,13 +16,15 @@ pub fn lane_sum(l: &[f32; LANES]) -> f32 {
     l.iter().sum()
 }
 
-/// Whether this CPU runs the pair loops with 256-bit lanes and fused multiply-add (checked once, cached by
+/// Whether this CPU runs the pair loops with 256-bit lanes, fused multiply-add and popcnt (checked once, cached by
 /// std).
 #[inline]
 pub fn wide_lanes() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma")
+            && std::arch::is_x86_feature_detected!("popcnt")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -41,6 +43,26 @@ pub fn test_noise(mut seed: u64) -> impl FnMut() -> f32 {
     }
 }
 
+/// For each 8-bit mask of lanes, the set lanes in order (the rest: don't care), so a block's selected slots
+/// are written as one block of 8 without branches.
+const COMPRESS: [[u8; LANES]; 1 << LANES] = {
+    let mut t = [[0u8; LANES]; 1 << LANES];
+    let mut m = 0;
+    while m < 1 << LANES {
+        let mut n = 0;
+        let mut l = 0;
+        while l < LANES {
+            if m & (1 << l) != 0 {
+                t[m][n] = l as u8;
+                n += 1;
+            }
+            l += 1;
+        }
+        m += 1;
+    }
+    t
+};
+
 /// Where padding entries are put: far outside any support, small enough that squares stay finite in f32.
 const FAR: f32 = 1.0e15;
 
@@ -53,6 +75,8 @@ pub struct Candidates<const D: usize> {
     pub pr2: Vec<f32>,
     /// Index of each candidate in the particle arrays (padding: `u32::MAX`); filled by [`Self::fill_motion`].
     pub idx: Vec<u32>,
+    /// Slots of the candidates within reach of one particle, padded to whole blocks ([`Self::select`]).
+    sel: Vec<u32>,
 }
 
 impl<const D: usize> Default for Candidates<D> {
@@ -63,6 +87,7 @@ impl<const D: usize> Default for Candidates<D> {
             r: Vec::new(),
             pr2: Vec::new(),
             idx: Vec::new(),
+            sel: Vec::new(),
         }
     }
 }
@@ -106,7 +131,8 @@ impl<const D: usize> Candidates<D> {
     }
 
     /// Copies positions, velocities and indices only (densities and p/ρ² are left empty: use
-    /// [`Self::motion_blocks`] and [`Self::motion_block`]), padded like [`Self::fill`].
+    /// [`Self::motion_blocks`] and [`Self::motion_block`]), padded like [`Self::fill`] but always with at
+    /// least one padding entry, which [`Self::select`] pads its selection with.
     pub fn fill_motion(&mut self, ranges: &Ranges, n: usize, x: &[Vec<f32>; D], v: &[Vec<f32>; D]) {
         for d in 0..D {
             self.x[d].clear();
@@ -123,12 +149,87 @@ impl<const D: usize> Candidates<D> {
             }
             self.idx.extend(lo as u32..hi as u32);
         }
-        let padded = self.idx.len().div_ceil(LANES) * LANES;
+        let padded = (self.idx.len() + 1).div_ceil(LANES) * LANES;
         for d in 0..D {
             self.x[d].resize(padded, FAR);
             self.v[d].resize(padded, 0.0);
         }
         self.idx.resize(padded, u32::MAX);
+    }
+
+    /// Selects the candidates (after [`Self::fill_motion`]) closer to `xa` than √`reach2`, in candidate
+    /// order, and pads the selection to whole blocks with a padding entry: the expensive part of a pair
+    /// loop then runs over [`Self::selected_block`]s of neighbours only, instead of every candidate of the
+    /// (2·REACH + 1)^D cells around (a quarter of them are in reach in 3D). Branch-free: every slot is
+    /// written and kept only if it is in reach.
+    #[inline(always)]
+    pub fn select(&mut self, xa: [f32; D], reach2: f32) {
+        let blocks = self.motion_blocks();
+        self.sel.clear();
+        // Each block writes a whole block of slots at the end of the selection.
+        self.sel.reserve(blocks * LANES + LANES);
+        let out = self.sel.as_mut_ptr();
+        let mut n = 0;
+        for b in 0..blocks {
+            let s = b * LANES;
+            let xs: [&[f32; LANES]; D] =
+                std::array::from_fn(|d| self.x[d][s..s + LANES].try_into().expect("whole block"));
+            let mut r2 = [0.0f32; LANES];
+            for d in 0..D {
+                for l in 0..LANES {
+                    let dx = xa[d] - xs[d][l];
+                    r2[l] += dx * dx;
+                }
+            }
+            let mut mask = 0usize;
+            for (l, &r2) in r2.iter().enumerate() {
+                mask |= ((r2 < reach2) as usize) << l;
+            }
+            let lanes = &COMPRESS[mask];
+            for (l, &lane) in lanes.iter().enumerate() {
+                // SAFETY: n ≤ s, so n + l < blocks · LANES + LANES, the reserved capacity.
+                unsafe { out.add(n + l).write((s + lane as usize) as u32) };
+            }
+            n += mask.count_ones() as usize;
+        }
+        // The last slot is always padding (`fill_motion`).
+        let pad = (blocks * LANES - 1) as u32;
+        while n % LANES != 0 {
+            // SAFETY: n < blocks · LANES + LANES, within the reserved capacity.
+            unsafe { out.add(n).write(pad) };
+            n += 1;
+        }
+        // SAFETY: the first n entries were written above.
+        unsafe { self.sel.set_len(n) };
+    }
+
+    /// Number of blocks of [`LANES`] of the last [`Self::select`].
+    #[inline]
+    pub fn selected_blocks(&self) -> usize {
+        self.sel.len() / LANES
+    }
+
+    /// Block `b` of the last [`Self::select`]: positions, velocities and particle indices of its lanes,
+    /// gathered from the candidates.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    pub fn selected_block(&self, b: usize) -> ([[f32; LANES]; D], [[f32; LANES]; D], [u32; LANES]) {
+        let slots: &[u32; LANES] = self.sel[b * LANES..(b + 1) * LANES]
+            .try_into()
+            .expect("whole block");
+        let n = self.idx.len();
+        // Slots come from `select` over this fill: all below n (checked once per block, not per load).
+        assert!(slots.iter().all(|&s| (s as usize) < n));
+        let gather = |v: &[f32]| -> [f32; LANES] {
+            // SAFETY: every slot is below n = v.len() (asserted above; x, v and idx have one length).
+            std::array::from_fn(|l| unsafe { *v.get_unchecked(slots[l] as usize) })
+        };
+        (
+            std::array::from_fn(|d| gather(&self.x[d])),
+            std::array::from_fn(|d| gather(&self.v[d])),
+            // SAFETY: as above.
+            std::array::from_fn(|l| unsafe { *self.idx.get_unchecked(slots[l] as usize) }),
+        )
     }
 
     /// Number of blocks of [`LANES`] (after [`Self::fill`]).
@@ -213,5 +314,40 @@ mod tests {
         c.fill(&ranges, 1, &x, &v, &r, &p, 1000.0);
         assert_eq!(c.r.len(), LANES);
         assert_eq!(c.block(0).0[0][2], FAR);
+    }
+
+    #[test]
+    fn select_keeps_exactly_the_candidates_in_reach_in_order() {
+        let mut rnd = test_noise(3);
+        let n = 37;
+        let x: [Vec<f32>; 3] = std::array::from_fn(|_| (0..n).map(|_| rnd()).collect());
+        let v: [Vec<f32>; 3] = std::array::from_fn(|_| (0..n).map(|_| rnd()).collect());
+        let mut ranges = NO_RANGES;
+        ranges[0] = (0, 20);
+        ranges[1] = (25, n as u32);
+        let mut c = Candidates::<3>::default();
+        c.fill_motion(&ranges, 2, &x, &v);
+        let xa = [0.1f32, -0.05, 0.0];
+        let reach2 = 0.16f32;
+        c.select(xa, reach2);
+        let mut got = Vec::new();
+        for b in 0..c.selected_blocks() {
+            let (bx, bv, idx) = c.selected_block(b);
+            for l in 0..LANES {
+                if idx[l] == u32::MAX {
+                    assert_eq!(bx[0][l], FAR, "padding is far away");
+                    continue;
+                }
+                let i = idx[l] as usize;
+                assert_eq!(bv[2][l], v[2][i]);
+                got.push(i);
+            }
+        }
+        let want: Vec<usize> = (0..20)
+            .chain(25..n)
+            .filter(|&i| (0..3).map(|d| (xa[d] - x[d][i]).powi(2)).sum::<f32>() < reach2)
+            .collect();
+        assert!(!want.is_empty() && want.len() < 37 - 5);
+        assert_eq!(got, want);
     }
 }

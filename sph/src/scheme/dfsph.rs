@@ -201,10 +201,12 @@ fn hood<const D: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     (xa, va): ([f32; D], [f32; D]),
-    (fc, bc): (&Candidates<D>, &Candidates<D>),
+    (fc, bc): (&mut Candidates<D>, &mut Candidates<D>),
     j: &mut Vec<u32>,
     g: &mut Vec<[f32; D]>,
 ) -> Hood<D> {
+    fc.select(xa, c.pair.support2);
+    bc.select(xa, c.pair.support2);
     let z = [0.0f32; LANES];
     let mut s = HoodLanes {
         density: z,
@@ -219,16 +221,16 @@ fn hood<const D: usize, K: Kernel>(
     let first = j.len();
     // Every lane is written after the end of the list and kept only if it is a neighbour (no branches on
     // whether it is).
-    j.reserve(fc.motion_blocks() * LANES);
-    g.reserve(fc.motion_blocks() * LANES);
+    j.reserve(fc.selected_blocks() * LANES);
+    g.reserve(fc.selected_blocks() * LANES);
     let (js, gs) = (j.spare_capacity_mut(), g.spare_capacity_mut());
     let mut n = 0;
     let (mf, mw) = (c.pair.m_fluid, c.pair.m_bound);
     // Monaghan's Π_ab = −α c0 h min(v_ab·x_ab, 0) / ((r² + η²) ρ_rest): the constant factor of each.
     let visc = c.pair.alpha * c.pair.c0 * c.pair.h / c.rho_rest;
     let visc_b = c.pair.alpha_bound * c.pair.c0 * c.pair.h / c.rho_rest;
-    for blk in 0..fc.motion_blocks() {
-        let (xs, vs, idx) = fc.motion_block(blk);
+    for blk in 0..fc.selected_blocks() {
+        let (xs, vs, idx) = fc.selected_block(blk);
         let mut gl = [z; D];
         let mut hit = [false; LANES];
         for l in 0..LANES {
@@ -269,8 +271,8 @@ fn hood<const D: usize, K: Kernel>(
         j.set_len(first + n);
         g.set_len(first + n);
     }
-    for blk in 0..bc.motion_blocks() {
-        let (xs, vs, _) = bc.motion_block(blk);
+    for blk in 0..bc.selected_blocks() {
+        let (xs, vs, _) = bc.selected_block(blk);
         for l in 0..LANES {
             let mut dx = [0.0f32; D];
             let mut r2 = 0.0f32;
@@ -314,17 +316,21 @@ fn hood<const D: usize, K: Kernel>(
 
 /// [`hood`] compiled for AVX2 + FMA: the same source, its lane loops vectorised 8 wide.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2,fma,popcnt")]
 fn hood_avx2<const D: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     own: ([f32; D], [f32; D]),
-    cands: (&Candidates<D>, &Candidates<D>),
+    cands: (&mut Candidates<D>, &mut Candidates<D>),
     j: &mut Vec<u32>,
     g: &mut Vec<[f32; D]>,
 ) -> Hood<D> {
     hood(k, c, own, cands, j, g)
 }
+
+/// Cells along x (one row) whose particles share one copy of candidates in pass 1: fewer, longer copies,
+/// for more candidates per particle, which [`Candidates::select`] sifts cheaply before the kernel sums.
+const RUN: u32 = 3;
 
 /// Pass 1 for one chunk: neighbour lists, density, factor and non-pressure acceleration.
 fn build_chunk<const D: usize, K: Kernel>(
@@ -344,7 +350,8 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.wf.clear();
     lists.mb.clear();
     lists.full.clear();
-    let mut filled = u32::MAX;
+    // The run of cells `filled..run_end` (one row) whose candidates are loaded.
+    let (mut filled, mut run_end) = (u32::MAX, u32::MAX);
     for o in 0..rho.len() {
         let a = first + o;
         if f.id[a] & HALO != 0 {
@@ -360,12 +367,13 @@ fn build_chunk<const D: usize, K: Kernel>(
             lists.full.push(false);
             continue;
         }
-        if f.cell[a] != filled {
-            // Particles are sorted by cell: the candidates change only when the cell does.
+        if !(filled..run_end).contains(&f.cell[a]) {
+            // Particles are sorted by cell: the candidates change only when the run of cells does.
             filled = f.cell[a];
-            let n = p.grid.ranges(filled, &f.starts, &mut ranges);
+            run_end = p.grid.run_end(filled, RUN);
+            let n = p.grid.run_ranges(filled, run_end, &f.starts, &mut ranges);
             fc.fill_motion(&ranges, n, &f.x, &f.v);
-            let n = p.grid.ranges(filled, &b.starts, &mut ranges);
+            let n = p.grid.run_ranges(filled, run_end, &b.starts, &mut ranges);
             bc.fill_motion(&ranges, n, &b.x, &b.v);
         }
         lists.start.push(lists.j.len() as u32);
@@ -1104,13 +1112,13 @@ mod tests {
                 std::array::from_fn(|d| v[d][a]),
             );
             let (mut j, mut g) = (Vec::new(), Vec::new());
-            let mut fast = vec![hood(&k, &c, own, (&fc, &bc), &mut j, &mut g)];
+            let mut fast = vec![hood(&k, &c, own, (&mut fc, &mut bc), &mut j, &mut g)];
             let mut lists = vec![j];
             #[cfg(target_arch = "x86_64")]
             if wide_lanes() {
                 let (mut j, mut g) = (Vec::new(), Vec::new());
                 // SAFETY: checked just above.
-                fast.push(unsafe { hood_avx2(&k, &c, own, (&fc, &bc), &mut j, &mut g) });
+                fast.push(unsafe { hood_avx2(&k, &c, own, (&mut fc, &mut bc), &mut j, &mut g) });
                 lists.push(j);
             }
             let gs = grad
