@@ -141,6 +141,19 @@ impl<const D: usize> Candidates<D> {
         self.idx.clear();
         self.r.clear();
         self.pr2.clear();
+        // Grow to twice what is needed: the candidates of a run of cells vary more than a cell's,
+        // and a step should stop allocating soon after the flow has got going.
+        let total: usize = ranges[..n].iter().map(|&(lo, hi)| (hi - lo) as usize).sum();
+        let want = (total + 1).div_ceil(LANES) * LANES;
+        if self.idx.capacity() < want {
+            let room = 2 * want;
+            for d in 0..D {
+                self.x[d].reserve(room);
+                self.v[d].reserve(room);
+            }
+            self.idx.reserve(room);
+            self.sel.reserve(room + LANES);
+        }
         for &(lo, hi) in &ranges[..n] {
             let (lo, hi) = (lo as usize, hi as usize);
             for d in 0..D {

@@ -221,8 +221,9 @@ fn hood<const D: usize, K: Kernel>(
     let first = j.len();
     // Every lane is written after the end of the list and kept only if it is a neighbour (no branches on
     // whether it is).
-    j.reserve(fc.selected_blocks() * LANES);
-    g.reserve(fc.selected_blocks() * LANES);
+    // Room for every candidate, not just the neighbours: the lists' capacity settles early in a run.
+    j.reserve(fc.motion_blocks() * LANES);
+    g.reserve(fc.motion_blocks() * LANES);
     let (js, gs) = (j.spare_capacity_mut(), g.spare_capacity_mut());
     let mut n = 0;
     let (mf, mw) = (c.pair.m_fluid, c.pair.m_bound);
