@@ -63,6 +63,24 @@ const COMPRESS: [[u8; LANES]; 1 << LANES] = {
     t
 };
 
+/// Gives every chunk's candidates (liquid and walls separately) room for 2.5 times the most any of them has
+/// needed so far, once theirs falls below 1.25 times that: each chunk's own storage grows only to what its
+/// own runs of cells have held, and a chunk that meets a fuller run later in the flow would allocate inside
+/// a step. Called before each pass; after a growth the most needed must double before the next.
+pub fn share_room<const D: usize>(pairs: &mut [(Candidates<D>, Candidates<D>)]) {
+    let peak = |f: fn(&(Candidates<D>, Candidates<D>)) -> &Candidates<D>| {
+        pairs.iter().map(|p| f(p).peak).max().unwrap_or(0)
+    };
+    let (pf, pb) = (peak(|p| &p.0), peak(|p| &p.1));
+    for (f, b) in pairs.iter_mut() {
+        for (c, peak) in [(f, pf), (b, pb)] {
+            if 4 * c.x[0].capacity() < 5 * peak {
+                c.reserve(5 * peak / 2);
+            }
+        }
+    }
+}
+
 /// Where padding entries are put: far outside any support, small enough that squares stay finite in f32.
 const FAR: f32 = 1.0e15;
 
@@ -77,6 +95,8 @@ pub struct Candidates<const D: usize> {
     pub idx: Vec<u32>,
     /// Slots of the candidates within reach of one particle, padded to whole blocks ([`Self::select`]).
     sel: Vec<u32>,
+    /// The most candidates (padded) a fill has needed ([`share_room`]).
+    peak: usize,
 }
 
 impl<const D: usize> Default for Candidates<D> {
@@ -88,6 +108,7 @@ impl<const D: usize> Default for Candidates<D> {
             pr2: Vec::new(),
             idx: Vec::new(),
             sel: Vec::new(),
+            peak: 0,
         }
     }
 }
@@ -112,6 +133,8 @@ impl<const D: usize> Candidates<D> {
         }
         self.r.clear();
         self.pr2.clear();
+        let total: usize = ranges[..n].iter().map(|&(lo, hi)| (hi - lo) as usize).sum();
+        self.grow(total.div_ceil(LANES) * LANES);
         for &(lo, hi) in &ranges[..n] {
             let (lo, hi) = (lo as usize, hi as usize);
             for d in 0..D {
@@ -130,6 +153,31 @@ impl<const D: usize> Candidates<D> {
         self.pr2.resize(padded, 0.0);
     }
 
+    /// Notes a fill of `want` candidates (padded) and, if the storage is too small for it, grows it to
+    /// twice that: the candidates of a run of cells vary more than a cell's, and a step should stop
+    /// allocating soon after the flow has got going.
+    fn grow(&mut self, want: usize) {
+        self.peak = self.peak.max(want);
+        if self.x[0].capacity() < want {
+            self.reserve(2 * want);
+        }
+    }
+
+    /// Room for `room` candidates in every array (the empty ones included: a few kB).
+    fn reserve(&mut self, room: usize) {
+        fn to<T>(v: &mut Vec<T>, room: usize) {
+            v.reserve(room.saturating_sub(v.len()));
+        }
+        for d in 0..D {
+            to(&mut self.x[d], room);
+            to(&mut self.v[d], room);
+        }
+        to(&mut self.r, room);
+        to(&mut self.pr2, room);
+        to(&mut self.idx, room);
+        to(&mut self.sel, room + LANES);
+    }
+
     /// Copies positions, velocities and indices only (densities and p/ρ² are left empty: use
     /// [`Self::motion_blocks`] and [`Self::motion_block`]), padded like [`Self::fill`] but always with at
     /// least one padding entry, which [`Self::select`] pads its selection with.
@@ -141,19 +189,8 @@ impl<const D: usize> Candidates<D> {
         self.idx.clear();
         self.r.clear();
         self.pr2.clear();
-        // Grow to twice what is needed: the candidates of a run of cells vary more than a cell's,
-        // and a step should stop allocating soon after the flow has got going.
         let total: usize = ranges[..n].iter().map(|&(lo, hi)| (hi - lo) as usize).sum();
-        let want = (total + 1).div_ceil(LANES) * LANES;
-        if self.idx.capacity() < want {
-            let room = 2 * want;
-            for d in 0..D {
-                self.x[d].reserve(room);
-                self.v[d].reserve(room);
-            }
-            self.idx.reserve(room);
-            self.sel.reserve(room + LANES);
-        }
+        self.grow((total + 1).div_ceil(LANES) * LANES);
         for &(lo, hi) in &ranges[..n] {
             let (lo, hi) = (lo as usize, hi as usize);
             for d in 0..D {

@@ -27,7 +27,8 @@
 //! the neighbour lists; every pass is a gather over fixed chunks that writes only its own particles, so
 //! results do not depend on the number of threads.
 
-use super::candidates::{lane_sum, wide_lanes, Candidates, LANES};
+use super::candidates::{lane_sum, share_room, wide_lanes, Candidates, LANES};
+use super::pair_sums::{divergence, push};
 use super::warm_start::{Columns, Setting};
 use super::{FrameTerms, PassTotals, Ranks, CHUNK};
 use crate::domain::Op;
@@ -73,7 +74,13 @@ struct Lists<const D: usize> {
     /// Offsets into `j`/`g` per particle of the chunk (len + 1).
     start: Vec<u32>,
     j: Vec<u32>,
+    /// ∇_a W_ab in 2D; in 3D `g4` holds them instead, padded to four lanes: the pressure iterations load
+    /// a pair's gradient (and the neighbour's velocity, `Workspace::vel4`) in one 16-byte load each.
     g: Vec<[f32; D]>,
+    g4: Vec<[f32; 4]>,
+    /// One past the largest index in `j` (0 if none): the passes check it once against the arrays they
+    /// read the neighbours from, then read them unchecked.
+    end_j: usize,
     /// Per particle of the chunk: Σ_b m_b ∇W_ab over its wall neighbours (every wall term of the solver is
     /// this sum times the particle's own k or velocity, and `wf`), the
     /// walls' moment about the tank origin per unit k, Σ_b x_b × (−MIRROR m_b ∇W_ab), and whether the
@@ -116,6 +123,8 @@ pub struct Workspace<const D: usize> {
     vel: Vec<[f32; D]>,
     k: Vec<f32>,
     ksum: Vec<f32>,
+    /// In 3D, `vel` padded to four lanes for the error pass's neighbour loads (refreshed before each).
+    vel4: Vec<[f32; 4]>,
     /// The divergence solver's total k.
     kdiv: Vec<f32>,
     /// Longest step the iteration control allows now (0: no limit yet).
@@ -197,13 +206,13 @@ struct HoodLanes<const D: usize> {
 /// The neighbourhood of liquid particle (xa, va) among the candidates of its cell (liquid `fc`, walls `bc`); appends its liquid neighbours (not itself) and their ∇W_ab to `j`/`g`.
 /// Branch-free over blocks of [`LANES`]: candidates beyond the support add nothing.
 #[inline(always)]
-fn hood<const D: usize, K: Kernel>(
+fn hood<const D: usize, const W: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     (xa, va): ([f32; D], [f32; D]),
     (fc, bc): (&mut Candidates<D>, &mut Candidates<D>),
     j: &mut Vec<u32>,
-    g: &mut Vec<[f32; D]>,
+    g: &mut Vec<[f32; W]>,
 ) -> Hood<D> {
     fc.select(xa, c.pair.support2);
     bc.select(xa, c.pair.support2);
@@ -263,7 +272,7 @@ fn hood<const D: usize, K: Kernel>(
         }
         for l in 0..LANES {
             js[n].write(idx[l]);
-            gs[n].write(std::array::from_fn(|d| gl[d][l]));
+            gs[n].write(std::array::from_fn(|d| if d < D { gl[d][l] } else { 0.0 }));
             n += hit[l] as usize;
         }
     }
@@ -318,13 +327,13 @@ fn hood<const D: usize, K: Kernel>(
 /// [`hood`] compiled for AVX2 + FMA: the same source, its lane loops vectorised 8 wide.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,popcnt")]
-fn hood_avx2<const D: usize, K: Kernel>(
+fn hood_avx2<const D: usize, const W: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     own: ([f32; D], [f32; D]),
     cands: (&mut Candidates<D>, &mut Candidates<D>),
     j: &mut Vec<u32>,
-    g: &mut Vec<[f32; D]>,
+    g: &mut Vec<[f32; W]>,
 ) -> Hood<D> {
     hood(k, c, own, cands, j, g)
 }
@@ -347,6 +356,7 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.start.clear();
     lists.j.clear();
     lists.g.clear();
+    lists.g4.clear();
     lists.gb.clear();
     lists.wf.clear();
     lists.mb.clear();
@@ -380,16 +390,21 @@ fn build_chunk<const D: usize, K: Kernel>(
         lists.start.push(lists.j.len() as u32);
         let xa: [f32; D] = std::array::from_fn(|d| f.x[d][a]);
         let va: [f32; D] = std::array::from_fn(|d| f.v[d][a]);
-        let hd = if p.wide {
+        let own = (xa, va);
+        let hd = match (p.wide, D == 3) {
             // SAFETY: `wide` is true only where the CPU reports AVX2 and FMA.
             #[cfg(target_arch = "x86_64")]
-            unsafe {
-                hood_avx2(p.k, c, (xa, va), (fc, bc), &mut lists.j, &mut lists.g)
-            }
+            (true, true) => unsafe {
+                hood_avx2(p.k, c, own, (fc, bc), &mut lists.j, &mut lists.g4)
+            },
+            #[cfg(target_arch = "x86_64")]
+            (true, false) => unsafe {
+                hood_avx2(p.k, c, own, (fc, bc), &mut lists.j, &mut lists.g)
+            },
             #[cfg(not(target_arch = "x86_64"))]
-            unreachable!("wide lanes are x86_64 only")
-        } else {
-            hood(p.k, c, (xa, va), (fc, bc), &mut lists.j, &mut lists.g)
+            (true, _) => unreachable!("wide lanes are x86_64 only"),
+            (false, true) => hood(p.k, c, own, (fc, bc), &mut lists.j, &mut lists.g4),
+            (false, false) => hood(p.k, c, own, (fc, bc), &mut lists.j, &mut lists.g),
         };
         let (grad, grad_b) = (hd.grad, hd.grad_b);
         // The particle's own k changes its density through (Σ_f m∇W + Σ_b m∇W)·(Σ_f m∇W + 2 Σ_b m∇W): the
@@ -432,39 +447,8 @@ fn build_chunk<const D: usize, K: Kernel>(
         }
     }
     lists.start.push(lists.j.len() as u32);
+    lists.end_j = lists.j.iter().max().map_or(0, |m| *m as usize + 1);
     out
-}
-
-/// Independent partial sums a neighbour-list loop keeps, so that consecutive pairs do not wait for each
-/// other's additions (one chain per dimension is bound by the adder's latency, not its throughput).
-const CHAINS: usize = 4;
-
-/// Σ over a particle's neighbour list of `term(j, ∇W)`, summed in [`CHAINS`] interleaved partial sums (a
-/// fixed order: the result depends only on the list, not on threads).
-#[inline(always)]
-fn pair_sum<const D: usize>(
-    j: &[u32],
-    g: &[[f32; D]],
-    term: impl Fn(u32, &[f32; D]) -> [f32; D],
-) -> [f32; D] {
-    let mut acc = [[0.0f32; D]; CHAINS];
-    let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
-    let (gc, gr) = g.split_at(jc.len());
-    for (js, gs) in jc.chunks_exact(CHAINS).zip(gc.chunks_exact(CHAINS)) {
-        for l in 0..CHAINS {
-            let t = term(js[l], &gs[l]);
-            for d in 0..D {
-                acc[l][d] += t[d];
-            }
-        }
-    }
-    for (l, (jj, gg)) in jr.iter().zip(gr).enumerate() {
-        let t = term(*jj, gg);
-        for d in 0..D {
-            acc[l][d] += t[d];
-        }
-    }
-    std::array::from_fn(|d| (acc[0][d] + acc[1][d]) + (acc[2][d] + acc[3][d]))
 }
 
 /// Which error a solve removes.
@@ -480,31 +464,30 @@ enum Mode {
 /// which keeps the Jacobi iteration stable and never sucks liquid together). Returns the summed error
 /// (density units).
 #[allow(clippy::too_many_arguments)]
-// Kept out of line (called once per chunk): the passes show by name in profiles.
-#[inline(never)]
-fn error_chunk<const D: usize>(
+#[inline(always)]
+fn error_chunk<const D: usize, const W: usize>(
     c: &Coefficients,
     mode: Mode,
     dt: f32,
-    lists: &Lists<D>,
-    vel: &[[f32; D]],
+    (lists, g): (&Lists<D>, &[[f32; W]]),
+    vel: &[[f32; W]],
     first: usize,
     (rho, factor): (&[f32], &[f32]),
     k: &mut [f32],
 ) -> Partial {
     let mut err = 0u64;
     let (inv_dt, inv_dt2) = (1.0 / dt, 1.0 / (dt * dt));
+    assert!(lists.end_j <= vel.len() && lists.start.len() == k.len() + 1);
     for o in 0..k.len() {
         let a = first + o;
         let va = vel[a];
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
+        // SAFETY: every index in the lists is below `end_j` (asserted above).
         let mut s = c.pair.m_fluid
-            * pair_sum(&lists.j[lo..hi], &lists.g[lo..hi], |j, g| {
-                let vb = vel[j as usize];
-                std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
-            })
-            .iter()
-            .sum::<f32>();
+            * unsafe { divergence(&lists.j[lo..hi], &g[lo..hi], vel, va) }
+                .iter()
+                .take(D)
+                .sum::<f32>();
         let gb = lists.gb[o];
         for d in 0..D {
             s += va[d] * gb[d];
@@ -533,31 +516,102 @@ fn error_chunk<const D: usize>(
 }
 
 /// Pass 3 for one chunk: the velocity change from k (the walls push back with the particle's own k).
-// Kept out of line, as `error_chunk`.
-#[inline(never)]
-fn update_chunk<const D: usize>(
+#[inline(always)]
+fn update_chunk<const D: usize, const W: usize>(
     c: &Coefficients,
     dt: f32,
-    lists: &Lists<D>,
+    (lists, g): (&Lists<D>, &[[f32; W]]),
     kall: &[f32],
     first: usize,
     vel: &mut [[f32; D]],
     ksum: &mut [f32],
 ) {
+    assert!(lists.end_j <= kall.len() && lists.start.len() == vel.len() + 1);
     for o in 0..vel.len() {
         let a = first + o;
         let ka = kall[a];
         ksum[o] += ka;
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
-        let acc = pair_sum(&lists.j[lo..hi], &lists.g[lo..hi], |j, g| {
-            let s = ka + kall[j as usize];
-            std::array::from_fn(|d| s * g[d])
-        });
+        // SAFETY: every index in the lists is below `end_j` (asserted above).
+        let acc = unsafe { push(&lists.j[lo..hi], &g[lo..hi], kall, ka) };
         let gb = lists.gb[o];
         for d in 0..D {
             vel[o][d] -= dt * (c.pair.m_fluid * acc[d] + MIRROR * ka * gb[d]);
         }
     }
+}
+
+/// [`error_chunk`] kept out of line (called once per chunk: the passes show by name in profiles), compiled
+/// with AVX (three-operand instructions, fewer register copies) where `wide`.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn error_pass<const D: usize, const W: usize>(
+    wide: bool,
+    c: &Coefficients,
+    mode: Mode,
+    dt: f32,
+    lists: (&Lists<D>, &[[f32; W]]),
+    vel: &[[f32; W]],
+    first: usize,
+    own: (&[f32], &[f32]),
+    k: &mut [f32],
+) -> Partial {
+    #[cfg(target_arch = "x86_64")]
+    if wide {
+        #[allow(clippy::too_many_arguments)]
+        #[target_feature(enable = "avx")]
+        fn avx<const D: usize, const W: usize>(
+            c: &Coefficients,
+            mode: Mode,
+            dt: f32,
+            lists: (&Lists<D>, &[[f32; W]]),
+            vel: &[[f32; W]],
+            first: usize,
+            own: (&[f32], &[f32]),
+            k: &mut [f32],
+        ) -> Partial {
+            error_chunk(c, mode, dt, lists, vel, first, own, k)
+        }
+        // SAFETY: `wide` is true only where the CPU reports AVX2 (and so AVX).
+        return unsafe { avx(c, mode, dt, lists, vel, first, own, k) };
+    }
+    let _ = wide;
+    error_chunk(c, mode, dt, lists, vel, first, own, k)
+}
+
+/// [`update_chunk`] out of line and with AVX where `wide`, as [`error_pass`].
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn update_pass<const D: usize, const W: usize>(
+    wide: bool,
+    c: &Coefficients,
+    dt: f32,
+    lists: (&Lists<D>, &[[f32; W]]),
+    kall: &[f32],
+    first: usize,
+    vel: &mut [[f32; D]],
+    ksum: &mut [f32],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if wide {
+        #[allow(clippy::too_many_arguments)]
+        #[target_feature(enable = "avx")]
+        fn avx<const D: usize, const W: usize>(
+            c: &Coefficients,
+            dt: f32,
+            lists: (&Lists<D>, &[[f32; W]]),
+            kall: &[f32],
+            first: usize,
+            vel: &mut [[f32; D]],
+            ksum: &mut [f32],
+        ) {
+            update_chunk(c, dt, lists, kall, first, vel, ksum)
+        }
+        // SAFETY: `wide` is true only where the CPU reports AVX2 (and so AVX).
+        return unsafe { avx(c, dt, lists, kall, first, vel, ksum) };
+    }
+    let _ = wide;
+    update_chunk(c, dt, lists, kall, first, vel, ksum)
 }
 
 /// The walls' force and moment on one chunk's liquid from its total k.
@@ -626,6 +680,21 @@ impl<const D: usize> Workspace<D> {
             partials,
             ..
         } = self;
+        share_room(candidates);
+        // The same for the neighbour lists: room for 2.5 times the longest any chunk has held, once a
+        // chunk's falls below 1.25 times that.
+        let peak = lists.iter().map(|l| l.j.len()).max().unwrap_or(0);
+        for l in lists.iter_mut() {
+            if 4 * l.j.capacity() < 5 * peak {
+                let room = 5 * peak / 2;
+                l.j.reserve(room.saturating_sub(l.j.len()));
+                if D == 3 {
+                    l.g4.reserve(room.saturating_sub(l.g4.len()));
+                } else {
+                    l.g.reserve(room.saturating_sub(l.g.len()));
+                }
+            }
+        }
         rho.par_chunks_mut(CHUNK)
             .zip(factor.par_chunks_mut(CHUNK))
             .zip(acc.par_chunks_mut(CHUNK))
@@ -638,31 +707,29 @@ impl<const D: usize> Workspace<D> {
 
     /// Pass 2: errors and k; returns the summed error in units of 1 / [`ERR_SCALE`].
     fn errors(&mut self, c: &Coefficients, mode: Mode, dt: f32) -> f64 {
+        let wide = wide_lanes();
         let Workspace {
             lists,
             rho,
             factor,
             vel,
+            vel4,
             k,
             partials,
             ..
         } = self;
-        let vel = &*vel;
+        let (vel, vel4) = (&*vel, &*vel4);
         k.par_chunks_mut(CHUNK)
             .zip(lists.par_iter())
             .enumerate()
             .map(|(ci, (kc, l))| {
                 let r = ci * CHUNK..(ci * CHUNK + kc.len());
-                error_chunk(
-                    c,
-                    mode,
-                    dt,
-                    l,
-                    vel,
-                    ci * CHUNK,
-                    (&rho[r.clone()], &factor[r]),
-                    kc,
-                )
+                let own = (&rho[r.clone()], &factor[r]);
+                if D == 3 {
+                    error_pass(wide, c, mode, dt, (l, &l.g4), vel4, ci * CHUNK, own, kc)
+                } else {
+                    error_pass(wide, c, mode, dt, (l, &l.g), vel, ci * CHUNK, own, kc)
+                }
             })
             .collect_into_vec(partials);
         merged(partials).error as f64
@@ -670,6 +737,7 @@ impl<const D: usize> Workspace<D> {
 
     /// Pass 3: velocity update.
     fn update(&mut self, c: &Coefficients, dt: f32) {
+        let wide = wide_lanes();
         let Workspace {
             lists,
             vel,
@@ -682,7 +750,29 @@ impl<const D: usize> Workspace<D> {
             .zip(ksum.par_chunks_mut(CHUNK))
             .zip(lists.par_iter())
             .enumerate()
-            .for_each(|(ci, ((v, ks), l))| update_chunk(c, dt, l, k, ci * CHUNK, v, ks));
+            .for_each(|(ci, ((v, ks), l))| {
+                if D == 3 {
+                    update_pass(wide, c, dt, (l, &l.g4), k, ci * CHUNK, v, ks)
+                } else {
+                    update_pass(wide, c, dt, (l, &l.g), k, ci * CHUNK, v, ks)
+                }
+            });
+    }
+
+    /// In 3D: `vel4` from `vel` (after every change of `vel`, before an error pass reads it).
+    fn pad_velocities(&mut self) {
+        if D != 3 {
+            return;
+        }
+        self.vel4.resize(self.vel.len(), [0.0; 4]);
+        self.vel4
+            .par_chunks_mut(CHUNK)
+            .zip(self.vel.par_chunks(CHUNK))
+            .for_each(|(w, v)| {
+                for (w, v) in w.iter_mut().zip(v) {
+                    *w = std::array::from_fn(|d| if d < D { v[d] } else { 0.0 });
+                }
+            });
     }
 
     /// The walls' force and moment on the liquid from the solve's total k.
@@ -729,6 +819,7 @@ impl<const D: usize> Workspace<D> {
         if let Some(r) = ranks.as_deref_mut() {
             r.sync_vector(&mut self.vel);
         }
+        self.pad_velocities();
         let total = ranks.as_ref().map_or(self.rho.len(), |r| r.total());
         let mut it = 0;
         loop {
@@ -745,6 +836,7 @@ impl<const D: usize> Workspace<D> {
             if let Some(r) = ranks.as_deref_mut() {
                 r.sync_vector(&mut self.vel);
             }
+            self.pad_velocities();
             it += 1;
         }
     }
@@ -1041,6 +1133,33 @@ mod tests {
         )
     }
 
+    /// [`hood`] (AVX2 lanes where `wide`) with gradient slots of W lanes: its sums, its neighbour list and
+    /// the sum of the listed gradients (whose lanes beyond D must be 0).
+    fn listed<const D: usize, const W: usize, K: Kernel>(
+        k: &K,
+        c: &Coefficients,
+        own: ([f32; D], [f32; D]),
+        cands: (&mut Candidates<D>, &mut Candidates<D>),
+        wide: bool,
+    ) -> (Hood<D>, Vec<u32>, [f64; D]) {
+        let (mut j, mut g) = (Vec::new(), Vec::<[f32; W]>::new());
+        let s = if wide {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: only where `wide_lanes()` holds.
+            unsafe {
+                hood_avx2(k, c, own, cands, &mut j, &mut g)
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            unreachable!()
+        } else {
+            hood(k, c, own, cands, &mut j, &mut g)
+        };
+        assert_eq!(g.len(), j.len());
+        assert!(g.iter().all(|g| g[D..].iter().all(|x| *x == 0.0)));
+        let sum = std::array::from_fn(|d| g.iter().map(|g| g[d] as f64).sum());
+        (s, j, sum)
+    }
+
     fn check<const D: usize, K: Kernel>() {
         let dp = 0.01f32;
         let h = 1.3 * dp;
@@ -1112,15 +1231,14 @@ mod tests {
                 std::array::from_fn(|d| x[d][a]),
                 std::array::from_fn(|d| v[d][a]),
             );
-            let (mut j, mut g) = (Vec::new(), Vec::new());
-            let mut fast = vec![hood(&k, &c, own, (&mut fc, &mut bc), &mut j, &mut g)];
-            let mut lists = vec![j];
-            #[cfg(target_arch = "x86_64")]
+            // Plain and AVX2 lanes, gradients in D and in 4 lanes.
+            let mut fast = vec![
+                listed::<D, D, K>(&k, &c, own, (&mut fc, &mut bc), false),
+                listed::<D, 4, K>(&k, &c, own, (&mut fc, &mut bc), false),
+            ];
             if wide_lanes() {
-                let (mut j, mut g) = (Vec::new(), Vec::new());
-                // SAFETY: checked just above.
-                fast.push(unsafe { hood_avx2(&k, &c, own, (&mut fc, &mut bc), &mut j, &mut g) });
-                lists.push(j);
+                fast.push(listed::<D, D, K>(&k, &c, own, (&mut fc, &mut bc), true));
+                fast.push(listed::<D, 4, K>(&k, &c, own, (&mut fc, &mut bc), true));
             }
             let gs = grad
                 .iter()
@@ -1128,7 +1246,7 @@ mod tests {
                 .map(|q| q.abs())
                 .fold(1e-9, f64::max);
             let vs = visc.iter().map(|q| q.abs()).fold(1e-9, f64::max);
-            for (s, j) in fast.iter().zip(&lists) {
+            for (s, j, gsum) in &fast {
                 assert!(
                     (s.density as f64 - density).abs() < 1e-5 * density,
                     "density"
@@ -1163,6 +1281,10 @@ mod tests {
                     );
                 }
                 assert_eq!(j, &list, "liquid neighbours");
+                for d in 0..D {
+                    let m = c.pair.m_fluid as f64;
+                    assert!((m * gsum[d] - grad[d]).abs() < 1e-4 * gs, "listed ∇W {d}");
+                }
                 assert_eq!(s.liquid as usize, list.len());
             }
             assert!(

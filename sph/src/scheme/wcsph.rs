@@ -5,7 +5,7 @@
 //! Gather form: every liquid particle loops over its neighbours in cell-sorted order and writes only its own
 //! rates, so threads never share a write; chunks of fixed size make the sums independent of the thread count.
 
-use super::candidates::{lane_sum, wide_lanes, Candidates, LANES};
+use super::candidates::{lane_sum, share_room, wide_lanes, Candidates, LANES};
 use super::{FrameTerms, PassTotals, CHUNK};
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
@@ -336,6 +336,7 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
     };
     work.candidates
         .resize_with(acc.len().div_ceil(CHUNK), Default::default);
+    share_room(&mut work.candidates);
     acc.par_chunks_mut(CHUNK)
         .zip(drho.par_chunks_mut(CHUNK))
         .zip(work.candidates.par_iter_mut())
