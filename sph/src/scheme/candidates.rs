@@ -95,8 +95,11 @@ pub struct Candidates<const D: usize> {
     pub idx: Vec<u32>,
     /// Slots of the candidates within reach of one particle, padded to whole blocks ([`Self::select`]).
     sel: Vec<u32>,
-    /// The most candidates (padded) a fill has needed ([`share_room`]).
+    /// The most candidates (padded) a fill has needed ([`share_room`]), and whether the fills are
+    /// [`Self::fill_motion`]'s (positions, velocities, indices) rather than [`Self::fill`]'s (positions,
+    /// velocities, densities, p/ρ²).
     peak: usize,
+    motion: bool,
 }
 
 impl<const D: usize> Default for Candidates<D> {
@@ -109,6 +112,7 @@ impl<const D: usize> Default for Candidates<D> {
             idx: Vec::new(),
             sel: Vec::new(),
             peak: 0,
+            motion: false,
         }
     }
 }
@@ -134,6 +138,7 @@ impl<const D: usize> Candidates<D> {
         self.r.clear();
         self.pr2.clear();
         let total: usize = ranges[..n].iter().map(|&(lo, hi)| (hi - lo) as usize).sum();
+        self.motion = false;
         self.grow(total.div_ceil(LANES) * LANES);
         for &(lo, hi) in &ranges[..n] {
             let (lo, hi) = (lo as usize, hi as usize);
@@ -163,7 +168,8 @@ impl<const D: usize> Candidates<D> {
         }
     }
 
-    /// Room for `room` candidates in every array (the empty ones included: a few kB).
+    /// Room for `room` candidates in every array the fills use. (Every caller asks for more than twice
+    /// the capacity, so std's growth gives exactly `room`, and `x[0]`'s capacity stands for all.)
     fn reserve(&mut self, room: usize) {
         fn to<T>(v: &mut Vec<T>, room: usize) {
             v.reserve(room.saturating_sub(v.len()));
@@ -172,10 +178,18 @@ impl<const D: usize> Candidates<D> {
             to(&mut self.x[d], room);
             to(&mut self.v[d], room);
         }
-        to(&mut self.r, room);
-        to(&mut self.pr2, room);
-        to(&mut self.idx, room);
-        to(&mut self.sel, room + LANES);
+        if self.motion {
+            to(&mut self.idx, room);
+            to(&mut self.sel, room + LANES);
+        } else {
+            to(&mut self.r, room);
+            to(&mut self.pr2, room);
+        }
+    }
+
+    /// The most candidates (padded) a fill has needed.
+    pub fn peak(&self) -> usize {
+        self.peak
     }
 
     /// Copies positions, velocities and indices only (densities and p/ρ² are left empty: use
@@ -190,6 +204,7 @@ impl<const D: usize> Candidates<D> {
         self.r.clear();
         self.pr2.clear();
         let total: usize = ranges[..n].iter().map(|&(lo, hi)| (hi - lo) as usize).sum();
+        self.motion = true;
         self.grow((total + 1).div_ceil(LANES) * LANES);
         for &(lo, hi) in &ranges[..n] {
             let (lo, hi) = (lo as usize, hi as usize);

@@ -74,8 +74,9 @@ struct Lists<const D: usize> {
     /// Offsets into `j`/`g` per particle of the chunk (len + 1).
     start: Vec<u32>,
     j: Vec<u32>,
-    /// ∇_a W_ab in 2D; in 3D `g4` holds them instead, padded to four lanes: the pressure iterations load
-    /// a pair's gradient (and the neighbour's velocity, `Workspace::vel4`) in one 16-byte load each.
+    /// ∇_a W_ab in 2D; in 3D `g4` holds them instead, padded to four lanes (the last 0): on x86_64 the
+    /// pressure iterations load a pair's gradient (and the neighbour's velocity, `Workspace::vel4`) in one
+    /// 16-byte load each.
     g: Vec<[f32; D]>,
     g4: Vec<[f32; 4]>,
     /// One past the largest index in `j` (0 if none): the passes check it once against the arrays they
@@ -203,7 +204,8 @@ struct HoodLanes<const D: usize> {
     walls: [f32; LANES],
 }
 
-/// The neighbourhood of liquid particle (xa, va) among the candidates of its cell (liquid `fc`, walls `bc`); appends its liquid neighbours (not itself) and their ∇W_ab to `j`/`g`.
+/// The neighbourhood of liquid particle (xa, va) among the candidates of its cell (liquid `fc`, walls `bc`); appends its liquid neighbours (not itself) and their ∇W_ab to `j`/`g` (in W lanes, those beyond D
+/// written as 0).
 /// Branch-free over blocks of [`LANES`]: candidates beyond the support add nothing.
 #[inline(always)]
 fn hood<const D: usize, const W: usize, K: Kernel>(
@@ -357,6 +359,8 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.j.clear();
     lists.g.clear();
     lists.g4.clear();
+    // Until the lists are whole again (a build cut short leaves no bound the passes would trust).
+    lists.end_j = usize::MAX;
     lists.gb.clear();
     lists.wf.clear();
     lists.mb.clear();
@@ -667,6 +671,7 @@ impl<const D: usize> Workspace<D> {
         self.vel.resize(n, [0.0; D]);
         self.k.resize(n, 0.0);
         self.ksum.resize(n, 0.0);
+        self.vel4.resize(if D == 3 { n } else { 0 }, [0.0; 4]);
     }
 
     /// Pass 1 over all particles; returns the merged totals.
@@ -681,17 +686,19 @@ impl<const D: usize> Workspace<D> {
             ..
         } = self;
         share_room(candidates);
-        // The same for the neighbour lists: room for 2.5 times the longest any chunk has held, once a
-        // chunk's falls below 1.25 times that.
+        // The same for the neighbour lists, more tightly (they are most of the solver's memory): room for
+        // the longest list any chunk has held plus a quarter, plus one run's candidates (what `hood`
+        // reserves beyond the end), once a chunk's falls below the longest plus a sixteenth.
         let peak = lists.iter().map(|l| l.j.len()).max().unwrap_or(0);
+        let cands = candidates.iter().map(|c| c.0.peak()).max().unwrap_or(0);
         for l in lists.iter_mut() {
-            if 4 * l.j.capacity() < 5 * peak {
-                let room = 5 * peak / 2;
-                l.j.reserve(room.saturating_sub(l.j.len()));
+            if l.j.capacity() < peak + peak / 16 + cands {
+                let room = peak + peak / 4 + cands;
+                l.j.reserve_exact(room.saturating_sub(l.j.len()));
                 if D == 3 {
-                    l.g4.reserve(room.saturating_sub(l.g4.len()));
+                    l.g4.reserve_exact(room.saturating_sub(l.g4.len()));
                 } else {
-                    l.g.reserve(room.saturating_sub(l.g.len()));
+                    l.g.reserve_exact(room.saturating_sub(l.g.len()));
                 }
             }
         }

@@ -53,7 +53,7 @@ pub unsafe fn divergence<const W: usize>(
     if W == 4 {
         // SAFETY: W == 4, so these are the same types; the caller guarantees j < vel.len().
         let r = unsafe { sse::divergence(j, as4(g), as4(vel), std::array::from_fn(|d| va[d])) };
-        return std::array::from_fn(|d| r[d % 4]);
+        return std::array::from_fn(|d| r[d]);
     }
     pair_sum(j, g, |j, g| {
         // SAFETY: the caller guarantees j < vel.len().
@@ -72,7 +72,7 @@ pub unsafe fn push<const W: usize>(j: &[u32], g: &[[f32; W]], k: &[f32], ka: f32
     if W == 4 {
         // SAFETY: W == 4, so these are the same types; the caller guarantees j < k.len().
         let r = unsafe { sse::push(j, as4(g), k, ka) };
-        return std::array::from_fn(|d| r[d % 4]);
+        return std::array::from_fn(|d| r[d]);
     }
     pair_sum(j, g, |j, g| {
         // SAFETY: the caller guarantees j < k.len().
@@ -88,7 +88,7 @@ pub unsafe fn push<const W: usize>(j: &[u32], g: &[[f32; W]], k: &[f32], ka: f32
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn as4<const W: usize>(v: &[[f32; W]]) -> &[[f32; 4]] {
-    debug_assert_eq!(W, 4);
+    assert_eq!(W, 4);
     // SAFETY: the caller guarantees W == 4: same size, alignment and layout.
     unsafe { std::slice::from_raw_parts(v.as_ptr().cast(), v.len()) }
 }
@@ -115,7 +115,8 @@ mod sse {
     /// [`super::pair_sum`]'s chains and closing additions on four lanes.
     #[inline(always)]
     fn chains(j: &[u32], g: &[[f32; 4]], term: impl Fn(u32, __m128) -> __m128) -> [f32; 4] {
-        // SAFETY (every intrinsic below): SSE is part of x86_64; no memory is touched.
+        // SAFETY (the arithmetic intrinsics below): SSE is part of x86_64; they touch no memory (`load` has
+        // its own note).
         let mut acc = [unsafe { _mm_setzero_ps() }; CHAINS];
         let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
         let (gc, gr) = g.split_at(jc.len());
