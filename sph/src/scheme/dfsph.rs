@@ -545,8 +545,25 @@ fn update_chunk<const D: usize, const W: usize>(
     }
 }
 
-/// [`error_chunk`] kept out of line (called once per chunk: the passes show by name in profiles), compiled
-/// with AVX (three-operand instructions, fewer register copies) where `wide`.
+/// Runs `f` compiled with AVX where `wide` (three-operand instructions, fewer register copies: `f` and what
+/// it inlines are compiled into the AVX function), plainly elsewhere.
+#[inline(always)]
+fn maybe_avx<R>(wide: bool, f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    if wide {
+        #[target_feature(enable = "avx")]
+        fn avx<R>(f: impl FnOnce() -> R) -> R {
+            f()
+        }
+        // SAFETY: `wide` is true only where the CPU reports AVX2 (and so AVX).
+        return unsafe { avx(f) };
+    }
+    let _ = wide;
+    f()
+}
+
+/// [`error_chunk`] kept out of line (called once per chunk: the passes show by name in profiles, with AVX
+/// as `maybe_avx::avx` instantiated for this function's closure), with AVX where `wide`.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn error_pass<const D: usize, const W: usize>(
@@ -560,27 +577,7 @@ fn error_pass<const D: usize, const W: usize>(
     own: (&[f32], &[f32]),
     k: &mut [f32],
 ) -> Partial {
-    #[cfg(target_arch = "x86_64")]
-    if wide {
-        #[allow(clippy::too_many_arguments)]
-        #[target_feature(enable = "avx")]
-        fn avx<const D: usize, const W: usize>(
-            c: &Coefficients,
-            mode: Mode,
-            dt: f32,
-            lists: (&Lists<D>, &[[f32; W]]),
-            vel: &[[f32; W]],
-            first: usize,
-            own: (&[f32], &[f32]),
-            k: &mut [f32],
-        ) -> Partial {
-            error_chunk(c, mode, dt, lists, vel, first, own, k)
-        }
-        // SAFETY: `wide` is true only where the CPU reports AVX2 (and so AVX).
-        return unsafe { avx(c, mode, dt, lists, vel, first, own, k) };
-    }
-    let _ = wide;
-    error_chunk(c, mode, dt, lists, vel, first, own, k)
+    maybe_avx(wide, || error_chunk(c, mode, dt, lists, vel, first, own, k))
 }
 
 /// [`update_chunk`] out of line and with AVX where `wide`, as [`error_pass`].
@@ -596,26 +593,7 @@ fn update_pass<const D: usize, const W: usize>(
     vel: &mut [[f32; D]],
     ksum: &mut [f32],
 ) {
-    #[cfg(target_arch = "x86_64")]
-    if wide {
-        #[allow(clippy::too_many_arguments)]
-        #[target_feature(enable = "avx")]
-        fn avx<const D: usize, const W: usize>(
-            c: &Coefficients,
-            dt: f32,
-            lists: (&Lists<D>, &[[f32; W]]),
-            kall: &[f32],
-            first: usize,
-            vel: &mut [[f32; D]],
-            ksum: &mut [f32],
-        ) {
-            update_chunk(c, dt, lists, kall, first, vel, ksum)
-        }
-        // SAFETY: `wide` is true only where the CPU reports AVX2 (and so AVX).
-        return unsafe { avx(c, dt, lists, kall, first, vel, ksum) };
-    }
-    let _ = wide;
-    update_chunk(c, dt, lists, kall, first, vel, ksum)
+    maybe_avx(wide, || update_chunk(c, dt, lists, kall, first, vel, ksum))
 }
 
 /// The walls' force and moment on one chunk's liquid from its total k.
