@@ -404,6 +404,9 @@ fn tank_moving_at_constant_velocity_far_away_behaves_as_at_rest() {
 fn far_equals_near(p: SimParams, slosh: &dyn TankMotion, far_motion: &dyn TankMotion) {
     let mut near = sph::build(p.clone()).unwrap();
     let mut far = sph::build(p).unwrap();
+    let fill = near.observe(slosh).unwrap().probes[0];
+    // How far probe 0 moved from its level at rest, at most, over the samples.
+    let mut moved = 0.0f64;
     for i in 1..=10 {
         let t = i as f64 * 0.1;
         near.advance_to(slosh, t).unwrap();
@@ -413,6 +416,7 @@ fn far_equals_near(p: SimParams, slosh: &dyn TankMotion, far_motion: &dyn TankMo
             far.observe(far_motion).unwrap(),
         );
         assert_eq!(a.time, b.time);
+        moved = moved.max((a.probes[0] - fill).abs());
         for (x, y) in a
             .probes
             .iter()
@@ -428,13 +432,9 @@ fn far_equals_near(p: SimParams, slosh: &dyn TankMotion, far_motion: &dyn TankMo
             );
         }
     }
-    // And the run did slosh: the probes moved.
-    let o = near.observe(slosh).unwrap();
-    assert!(
-        (o.probes[0] - 0.19).abs() > 1e-3,
-        "no sloshing: {:?}",
-        o.probes
-    );
+    eprintln!("far equals near: probe 0 moved up to {moved:.4} m");
+    // And the run did slosh: the probe moved (at some sample; any one may be a crossing of the level).
+    assert!(moved > 2e-3, "no sloshing: probe 0 moved {moved} m at most");
 }
 
 #[test]

@@ -27,7 +27,8 @@
 //! the neighbour lists; every pass is a gather over fixed chunks that writes only its own particles, so
 //! results do not depend on the number of threads.
 
-use super::candidates::{lane_sum, share_room, wide_lanes, Candidates, LANES};
+use super::candidates::{lane_sum, share_room, wide_lanes, Room, LANES};
+use super::near::Near;
 use super::pair_sums::{divergence, push};
 use super::warm_start::{Columns, Setting};
 use super::{FrameTerms, PassTotals, Ranks, CHUNK};
@@ -115,8 +116,8 @@ impl Partial {
 #[derive(Debug, Default)]
 pub struct Workspace<const D: usize> {
     lists: Vec<Lists<D>>,
-    /// Liquid and wall candidates of the cell being built, one pair per chunk.
-    candidates: Vec<(Candidates<D>, Candidates<D>)>,
+    /// The selected liquid and wall neighbours of the particle being built, one pair per chunk.
+    near: Vec<(Near<D>, Near<D>)>,
     /// Summed density, DFSPH factor, non-pressure acceleration, working velocity, k, Σk, per particle.
     rho: Vec<f32>,
     factor: Vec<f32>,
@@ -204,20 +205,34 @@ struct HoodLanes<const D: usize> {
     walls: [f32; LANES],
 }
 
-/// The neighbourhood of liquid particle (xa, va) among the candidates of its cell (liquid `fc`, walls `bc`); appends its liquid neighbours (not itself) and their ∇W_ab to `j`/`g` (in W lanes, those beyond D
-/// written as 0).
-/// Branch-free over blocks of [`LANES`]: candidates beyond the support add nothing.
+/// Where a particle's neighbours are: the rows of cells around it (ranges of the cell-sorted arrays) of the
+/// liquid and of the walls, and those arrays (positions, velocities).
+#[derive(Clone, Copy)]
+struct Around<'a, const D: usize> {
+    liquid: &'a [(u32, u32)],
+    walls: &'a [(u32, u32)],
+    fluid: (&'a [Vec<f32>; D], &'a [Vec<f32>; D]),
+    bound: (&'a [Vec<f32>; D], &'a [Vec<f32>; D]),
+}
+
+/// The neighbourhood of liquid particle (xa, va) among the particles `around` it, selected into `fs`
+/// (liquid) and `bs` (walls) (packed with AVX2 where `wide`); appends its liquid neighbours (not itself)
+/// and their ∇W_ab to `j`/`g` (in W lanes, those beyond D written as 0).
+/// Branch-free over blocks of [`LANES`]: padding beyond the support adds nothing.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn hood<const D: usize, const W: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     (xa, va): ([f32; D], [f32; D]),
-    (fc, bc): (&mut Candidates<D>, &mut Candidates<D>),
+    around: Around<'_, D>,
+    (fs, bs): (&mut Near<D>, &mut Near<D>),
     j: &mut Vec<u32>,
     g: &mut Vec<[f32; W]>,
+    wide: bool,
 ) -> Hood<D> {
-    fc.select(xa, c.pair.support2);
-    bc.select(xa, c.pair.support2);
+    fs.select(xa, c.pair.support2, around.liquid, around.fluid, wide);
+    bs.select(xa, c.pair.support2, around.walls, around.bound, wide);
     let z = [0.0f32; LANES];
     let mut s = HoodLanes {
         density: z,
@@ -232,28 +247,28 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
     let first = j.len();
     // Every lane is written after the end of the list and kept only if it is a neighbour (no branches on
     // whether it is).
-    // Room for every candidate, not just the neighbours: the lists' capacity settles early in a run.
-    j.reserve(fc.motion_blocks() * LANES);
-    g.reserve(fc.motion_blocks() * LANES);
+    // Room for every selected lane, padding included.
+    j.reserve(fs.blocks() * LANES);
+    g.reserve(fs.blocks() * LANES);
     let (js, gs) = (j.spare_capacity_mut(), g.spare_capacity_mut());
     let mut n = 0;
     let (mf, mw) = (c.pair.m_fluid, c.pair.m_bound);
     // Monaghan's Π_ab = −α c0 h min(v_ab·x_ab, 0) / ((r² + η²) ρ_rest): the constant factor of each.
     let visc = c.pair.alpha * c.pair.c0 * c.pair.h / c.rho_rest;
     let visc_b = c.pair.alpha_bound * c.pair.c0 * c.pair.h / c.rho_rest;
-    for blk in 0..fc.selected_blocks() {
-        let (xs, vs, idx) = fc.selected_block(blk);
+    for blk in 0..fs.blocks() {
+        let (dxs, ws, idx) = fs.block(blk);
         let mut gl = [z; D];
         let mut hit = [false; LANES];
         for l in 0..LANES {
-            let mut dx = [0.0f32; D];
-            let mut r2 = 0.0f32;
-            let mut vr = 0.0f32;
+            let dx: [f32; D] = std::array::from_fn(|d| dxs[d][l]);
+            let (mut r2, mut vr) = (0.0f32, 0.0f32);
             for d in 0..D {
-                dx[d] = xa[d] - xs[d][l];
                 r2 += dx[d] * dx[d];
-                vr += (va[d] - vs[d][l]) * dx[d];
+                vr += va[d] * dx[d];
             }
+            // (v_a − v_b)·(x_a − x_b)
+            let vr = vr - ws[l];
             let inside = r2 < c.pair.support2;
             let fin = if inside { 1.0f32 } else { 0.0 };
             let r = r2.sqrt();
@@ -283,17 +298,16 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
         j.set_len(first + n);
         g.set_len(first + n);
     }
-    for blk in 0..bc.selected_blocks() {
-        let (xs, vs, _) = bc.selected_block(blk);
+    for blk in 0..bs.blocks() {
+        let (dxs, ws, _) = bs.block(blk);
         for l in 0..LANES {
-            let mut dx = [0.0f32; D];
-            let mut r2 = 0.0f32;
-            let mut vr = 0.0f32;
+            let dx: [f32; D] = std::array::from_fn(|d| dxs[d][l]);
+            let (mut r2, mut vr) = (0.0f32, 0.0f32);
             for d in 0..D {
-                dx[d] = xa[d] - xs[d][l];
                 r2 += dx[d] * dx[d];
-                vr += (va[d] - vs[d][l]) * dx[d];
+                vr += va[d] * dx[d];
             }
+            let vr = vr - ws[l];
             let fin = if r2 < c.pair.support2 { 1.0f32 } else { 0.0 };
             let r = r2.sqrt();
             let gf = k.grad_factor(r) * fin;
@@ -302,9 +316,10 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
             for d in 0..D {
                 let gd = gf * dx[d];
                 s.grad_b[d][l] += mw * gd;
-                s.wflux[l] += mw * vs[d][l] * gd;
                 s.wall[d][l] -= mw * pi * gd;
             }
+            // m_b v_b·∇W_ab = m_b F(r) v_b·(x_a − x_b)
+            s.wflux[l] += mw * gf * ws[l];
             s.walls[l] += fin;
         }
     }
@@ -333,28 +348,26 @@ fn hood_avx2<const D: usize, const W: usize, K: Kernel>(
     k: &K,
     c: &Coefficients,
     own: ([f32; D], [f32; D]),
-    cands: (&mut Candidates<D>, &mut Candidates<D>),
+    around: Around<'_, D>,
+    near: (&mut Near<D>, &mut Near<D>),
     j: &mut Vec<u32>,
     g: &mut Vec<[f32; W]>,
 ) -> Hood<D> {
-    hood(k, c, own, cands, j, g)
+    hood(k, c, own, around, near, j, g, true)
 }
-
-/// Cells along x (one row) whose particles share one copy of candidates in pass 1: fewer, longer copies,
-/// for more candidates per particle, which [`Candidates::select`] sifts cheaply before the kernel sums.
-const RUN: u32 = 3;
 
 /// Pass 1 for one chunk: neighbour lists, density, factor and non-pressure acceleration.
 fn build_chunk<const D: usize, K: Kernel>(
     p: &Ctx<'_, D, K>,
     first: usize,
     lists: &mut Lists<D>,
-    (fc, bc): &mut (Candidates<D>, Candidates<D>),
+    (fs, bs): &mut (Near<D>, Near<D>),
     (rho, factor, acc): (&mut [f32], &mut [f32], &mut [[f32; D]]),
 ) -> Partial {
     let (c, f, b) = (p.c, p.fluid, p.bound);
     let mut out = Partial::default();
-    let mut ranges: Ranges = NO_RANGES;
+    let (mut liquid, mut walls): (Ranges, Ranges) = (NO_RANGES, NO_RANGES);
+    let (mut nl, mut nw) = (0, 0);
     lists.start.clear();
     lists.j.clear();
     lists.g.clear();
@@ -365,8 +378,8 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.wf.clear();
     lists.mb.clear();
     lists.full.clear();
-    // The run of cells `filled..run_end` (one row) whose candidates are loaded.
-    let (mut filled, mut run_end) = (u32::MAX, u32::MAX);
+    // The cell whose rows of neighbouring cells are in `liquid` and `walls`.
+    let mut cell = u32::MAX;
     for o in 0..rho.len() {
         let a = first + o;
         if f.id[a] & HALO != 0 {
@@ -382,33 +395,35 @@ fn build_chunk<const D: usize, K: Kernel>(
             lists.full.push(false);
             continue;
         }
-        if !(filled..run_end).contains(&f.cell[a]) {
-            // Particles are sorted by cell: the candidates change only when the run of cells does.
-            filled = f.cell[a];
-            run_end = p.grid.run_end(filled, RUN);
-            let n = p.grid.run_ranges(filled, run_end, &f.starts, &mut ranges);
-            fc.fill_motion(&ranges, n, &f.x, &f.v);
-            let n = p.grid.run_ranges(filled, run_end, &b.starts, &mut ranges);
-            bc.fill_motion(&ranges, n, &b.x, &b.v);
+        if f.cell[a] != cell {
+            // Particles are sorted by cell: the rows around change only with the cell.
+            cell = f.cell[a];
+            (nl, nw) =
+                p.grid
+                    .ranges_of_two(cell, (&f.starts, &mut liquid), (&b.starts, &mut walls));
         }
         lists.start.push(lists.j.len() as u32);
         let xa: [f32; D] = std::array::from_fn(|d| f.x[d][a]);
         let va: [f32; D] = std::array::from_fn(|d| f.v[d][a]);
         let own = (xa, va);
+        let around = Around {
+            liquid: &liquid[..nl],
+            walls: &walls[..nw],
+            fluid: (&f.x, &f.v),
+            bound: (&b.x, &b.v),
+        };
+        let near = (&mut *fs, &mut *bs);
+        let (j, g, g4) = (&mut lists.j, &mut lists.g, &mut lists.g4);
         let hd = match (p.wide, D == 3) {
-            // SAFETY: `wide` is true only where the CPU reports AVX2 and FMA.
+            // SAFETY: `wide` is true only where the CPU reports AVX2, FMA and popcnt.
             #[cfg(target_arch = "x86_64")]
-            (true, true) => unsafe {
-                hood_avx2(p.k, c, own, (fc, bc), &mut lists.j, &mut lists.g4)
-            },
+            (true, true) => unsafe { hood_avx2(p.k, c, own, around, near, j, g4) },
             #[cfg(target_arch = "x86_64")]
-            (true, false) => unsafe {
-                hood_avx2(p.k, c, own, (fc, bc), &mut lists.j, &mut lists.g)
-            },
+            (true, false) => unsafe { hood_avx2(p.k, c, own, around, near, j, g) },
             #[cfg(not(target_arch = "x86_64"))]
             (true, _) => unreachable!("wide lanes are x86_64 only"),
-            (false, true) => hood(p.k, c, own, (fc, bc), &mut lists.j, &mut lists.g4),
-            (false, false) => hood(p.k, c, own, (fc, bc), &mut lists.j, &mut lists.g),
+            (false, true) => hood(p.k, c, own, around, near, j, g4, false),
+            (false, false) => hood(p.k, c, own, around, near, j, g, false),
         };
         let (grad, grad_b) = (hd.grad, hd.grad_b);
         // The particle's own k changes its density through (Σ_f m∇W + Σ_b m∇W)·(Σ_f m∇W + 2 Σ_b m∇W): the
@@ -641,8 +656,7 @@ impl<const D: usize> Workspace<D> {
 
     fn resize(&mut self, n: usize) {
         self.lists.resize_with(n.div_ceil(CHUNK), Default::default);
-        self.candidates
-            .resize_with(n.div_ceil(CHUNK), Default::default);
+        self.near.resize_with(n.div_ceil(CHUNK), Default::default);
         self.rho.resize(n, 0.0);
         self.factor.resize(n, 0.0);
         self.acc.resize(n, [0.0; D]);
@@ -656,19 +670,19 @@ impl<const D: usize> Workspace<D> {
     fn build<K: Kernel>(&mut self, p: &Ctx<'_, D, K>) -> Partial {
         let Workspace {
             lists,
-            candidates,
+            near,
             rho,
             factor,
             acc,
             partials,
             ..
         } = self;
-        share_room(candidates);
+        share_room(near);
         // The same for the neighbour lists, more tightly (they are most of the solver's memory): room for
-        // the longest list any chunk has held plus a quarter, plus one run's candidates (what `hood`
-        // reserves beyond the end), once a chunk's falls below the longest plus a sixteenth.
+        // the longest list any chunk has held plus a quarter, plus one particle's candidates (more than
+        // what `hood` reserves beyond the end), once a chunk's falls below the longest plus a sixteenth.
         let peak = lists.iter().map(|l| l.j.len()).max().unwrap_or(0);
-        let cands = candidates.iter().map(|c| c.0.peak()).max().unwrap_or(0);
+        let cands = near.iter().map(|c| c.0.peak()).max().unwrap_or(0);
         for l in lists.iter_mut() {
             if l.j.capacity() < peak + peak / 16 + cands {
                 let room = peak + peak / 4 + cands;
@@ -683,7 +697,7 @@ impl<const D: usize> Workspace<D> {
         rho.par_chunks_mut(CHUNK)
             .zip(factor.par_chunks_mut(CHUNK))
             .zip(acc.par_chunks_mut(CHUNK))
-            .zip(lists.par_iter_mut().zip(candidates.par_iter_mut()))
+            .zip(lists.par_iter_mut().zip(near.par_iter_mut()))
             .enumerate()
             .map(|(ci, (((r, f), a), (l, cb)))| build_chunk(p, ci * CHUNK, l, cb, (r, f, a)))
             .collect_into_vec(partials);
@@ -1124,20 +1138,22 @@ mod tests {
         k: &K,
         c: &Coefficients,
         own: ([f32; D], [f32; D]),
-        cands: (&mut Candidates<D>, &mut Candidates<D>),
+        around: Around<'_, D>,
         wide: bool,
     ) -> (Hood<D>, Vec<u32>, [f64; D]) {
         let (mut j, mut g) = (Vec::new(), Vec::<[f32; W]>::new());
+        let (mut fs, mut bs) = (Near::default(), Near::default());
+        let near = (&mut fs, &mut bs);
         let s = if wide {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: only where `wide_lanes()` holds.
             unsafe {
-                hood_avx2(k, c, own, cands, &mut j, &mut g)
+                hood_avx2(k, c, own, around, near, &mut j, &mut g)
             }
             #[cfg(not(target_arch = "x86_64"))]
             unreachable!()
         } else {
-            hood(k, c, own, cands, &mut j, &mut g)
+            hood(k, c, own, around, near, &mut j, &mut g, false)
         };
         assert_eq!(g.len(), j.len());
         assert!(g.iter().all(|g| g[D..].iter().all(|x| *x == 0.0)));
@@ -1199,13 +1215,16 @@ mod tests {
         // The walls move (a floating body's): their velocities enter the viscosity and the wall flux.
         let vb: [Vec<f32>; D] =
             std::array::from_fn(|_| (0..xb[0].len()).map(|_| 0.3 * rnd()).collect());
-        let mut ranges = NO_RANGES;
-        ranges[0] = (0, x[0].len() as u32);
-        let mut fc = Candidates::<D>::default();
-        fc.fill_motion(&ranges, 1, &x, &v);
-        ranges[0] = (0, xb[0].len() as u32);
-        let mut bc = Candidates::<D>::default();
-        bc.fill_motion(&ranges, 1, &xb, &vb);
+        // The liquid in three rows, as the grid gives them.
+        let n = x[0].len() as u32;
+        let liquid = [(0, n / 3), (n / 3, 2 * n / 3), (2 * n / 3, n)];
+        let walls = [(0, xb[0].len() as u32)];
+        let around = Around {
+            liquid: &liquid,
+            walls: &walls,
+            fluid: (&x, &v),
+            bound: (&xb, &vb),
+        };
         // The middle particle and one in the bottom row.
         let n = x[0].len();
         let mut viscous_walls = false;
@@ -1218,12 +1237,12 @@ mod tests {
             );
             // Plain and AVX2 lanes, gradients in D and in 4 lanes.
             let mut fast = vec![
-                listed::<D, D, K>(&k, &c, own, (&mut fc, &mut bc), false),
-                listed::<D, 4, K>(&k, &c, own, (&mut fc, &mut bc), false),
+                listed::<D, D, K>(&k, &c, own, around, false),
+                listed::<D, 4, K>(&k, &c, own, around, false),
             ];
             if wide_lanes() {
-                fast.push(listed::<D, D, K>(&k, &c, own, (&mut fc, &mut bc), true));
-                fast.push(listed::<D, 4, K>(&k, &c, own, (&mut fc, &mut bc), true));
+                fast.push(listed::<D, D, K>(&k, &c, own, around, true));
+                fast.push(listed::<D, 4, K>(&k, &c, own, around, true));
             }
             let gs = grad
                 .iter()

@@ -239,7 +239,7 @@ fn chunk<const D: usize, K: Kernel>(
     let (c, bound) = (p.c, p.bound);
     let mass = c.m_fluid as f64;
     let mut tot = PassTotals::default();
-    let mut ranges: Ranges = NO_RANGES;
+    let (mut ranges, mut walls): (Ranges, Ranges) = (NO_RANGES, NO_RANGES);
     let mut filled = u32::MAX;
     for (o, (acc_a, drho_a)) in acc.iter_mut().zip(drho.iter_mut()).enumerate() {
         let a = first + o;
@@ -252,10 +252,11 @@ fn chunk<const D: usize, K: Kernel>(
         if p.cell[a] != filled {
             // Particles are sorted by cell: the candidates change only when the cell does.
             filled = p.cell[a];
-            let n = p.grid.ranges(filled, p.starts, &mut ranges);
-            fc.fill(&ranges, n, p.x, p.v, p.r, p.pr2, c.rho0);
-            let n = p.grid.ranges(filled, &bound.starts, &mut ranges);
-            bc.fill(&ranges, n, &bound.x, &bound.v, &bound.r, &bound.pr2, c.rho0);
+            let (nf, nb) =
+                p.grid
+                    .ranges_of_two(filled, (p.starts, &mut ranges), (&bound.starts, &mut walls));
+            fc.fill(&ranges, nf, p.x, p.v, p.r, p.pr2, c.rho0);
+            bc.fill(&walls, nb, &bound.x, &bound.v, &bound.r, &bound.pr2, c.rho0);
         }
         let own = Own {
             x: std::array::from_fn(|d| p.x[d][a]),
