@@ -534,8 +534,10 @@ fn error_chunk<const D: usize, const W: usize>(
     }
 }
 
-/// Pass 3 for one chunk: the velocity change from k (the walls push back with the particle's own k).
+/// Pass 3 for one chunk: the velocity change from k (the walls push back with the particle's own k), also
+/// written padded to four lanes into `vel4` unless that is empty.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn update_chunk<const D: usize, const W: usize>(
     c: &Coefficients,
     dt: f32,
@@ -544,8 +546,10 @@ fn update_chunk<const D: usize, const W: usize>(
     first: usize,
     vel: &mut [[f32; D]],
     ksum: &mut [f32],
+    vel4: &mut [[f32; 4]],
 ) {
     assert!(lists.end_j <= kall.len() && lists.start.len() == vel.len() + 1);
+    assert!(vel4.is_empty() || vel4.len() == vel.len());
     for o in 0..vel.len() {
         let a = first + o;
         let ka = kall[a];
@@ -556,6 +560,9 @@ fn update_chunk<const D: usize, const W: usize>(
         let gb = lists.gb[o];
         for d in 0..D {
             vel[o][d] -= dt * (c.pair.m_fluid * acc[d] + MIRROR * ka * gb[d]);
+        }
+        if let Some(p) = vel4.get_mut(o) {
+            *p = std::array::from_fn(|d| if d < D { vel[o][d] } else { 0.0 });
         }
     }
 }
@@ -605,10 +612,11 @@ fn update_pass<const D: usize, const W: usize>(
     lists: (&Lists<D>, &[[f32; W]]),
     kall: &[f32],
     first: usize,
-    vel: &mut [[f32; D]],
-    ksum: &mut [f32],
+    (vel, ksum, vel4): (&mut [[f32; D]], &mut [f32], &mut [[f32; 4]]),
 ) {
-    maybe_avx(wide, || update_chunk(c, dt, lists, kall, first, vel, ksum))
+    maybe_avx(wide, || {
+        update_chunk(c, dt, lists, kall, first, vel, ksum, vel4)
+    })
 }
 
 /// The walls' force and moment on one chunk's liquid from its total k.
@@ -735,27 +743,38 @@ impl<const D: usize> Workspace<D> {
     }
 
     /// Pass 3: velocity update.
+    /// Pass 3 over all particles; in 3D it also refreshes `vel4` (halo copies' velocities, which a halo
+    /// exchange changes afterwards, need [`Self::pad_velocities`]).
     fn update(&mut self, c: &Coefficients, dt: f32) {
         let wide = wide_lanes();
         let Workspace {
             lists,
             vel,
+            vel4,
             k,
             ksum,
             ..
         } = self;
         let k = &*k;
-        vel.par_chunks_mut(CHUNK)
-            .zip(ksum.par_chunks_mut(CHUNK))
-            .zip(lists.par_iter())
-            .enumerate()
-            .for_each(|(ci, ((v, ks), l))| {
-                if D == 3 {
-                    update_pass(wide, c, dt, (l, &l.g4), k, ci * CHUNK, v, ks)
-                } else {
-                    update_pass(wide, c, dt, (l, &l.g), k, ci * CHUNK, v, ks)
-                }
-            });
+        if D == 3 {
+            assert_eq!(vel4.len(), vel.len());
+            vel.par_chunks_mut(CHUNK)
+                .zip(ksum.par_chunks_mut(CHUNK))
+                .zip(vel4.par_chunks_mut(CHUNK))
+                .zip(lists.par_iter())
+                .enumerate()
+                .for_each(|(ci, (((v, ks), v4), l))| {
+                    update_pass(wide, c, dt, (l, &l.g4), k, ci * CHUNK, (v, ks, v4))
+                });
+        } else {
+            vel.par_chunks_mut(CHUNK)
+                .zip(ksum.par_chunks_mut(CHUNK))
+                .zip(lists.par_iter())
+                .enumerate()
+                .for_each(|(ci, ((v, ks), l))| {
+                    update_pass(wide, c, dt, (l, &l.g), k, ci * CHUNK, (v, ks, &mut []))
+                });
+        }
     }
 
     /// In 3D: `vel4` from `vel` (after every change of `vel`, before an error pass reads it).
@@ -817,8 +836,8 @@ impl<const D: usize> Workspace<D> {
         self.update(c, dt);
         if let Some(r) = ranks.as_deref_mut() {
             r.sync_vector(&mut self.vel);
+            self.pad_velocities();
         }
-        self.pad_velocities();
         let total = ranks.as_ref().map_or(self.rho.len(), |r| r.total());
         let mut it = 0;
         loop {
@@ -834,8 +853,8 @@ impl<const D: usize> Workspace<D> {
             self.update(c, dt);
             if let Some(r) = ranks.as_deref_mut() {
                 r.sync_vector(&mut self.vel);
+                self.pad_velocities();
             }
-            self.pad_velocities();
             it += 1;
         }
     }

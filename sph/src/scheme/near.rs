@@ -70,7 +70,12 @@ impl<const D: usize> Room for Near<D> {
         self.peak
     }
     fn capacity(&self) -> usize {
-        let dx = self.dx.iter().map(Vec::capacity).min().unwrap_or(usize::MAX);
+        let dx = self
+            .dx
+            .iter()
+            .map(Vec::capacity)
+            .min()
+            .unwrap_or(usize::MAX);
         dx.min(self.w.capacity()).min(self.idx.capacity())
     }
     fn reserve(&mut self, room: usize) {
