@@ -341,7 +341,7 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
     }
 }
 
-/// [`hood`] compiled for AVX2 + FMA: the same source, its lane loops vectorised 8 wide.
+/// [`hood`] compiled for AVX2 + FMA (and popcnt): the same source, its lane loops vectorised 8 wide.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,popcnt")]
 fn hood_avx2<const D: usize, const W: usize, K: Kernel>(
@@ -742,8 +742,7 @@ impl<const D: usize> Workspace<D> {
         merged(partials).error as f64
     }
 
-    /// Pass 3: velocity update.
-    /// Pass 3 over all particles; in 3D it also refreshes `vel4` (halo copies' velocities, which a halo
+    /// Pass 3 (velocity update) over all particles; in 3D it also refreshes `vel4` (halo copies' velocities, which a halo
     /// exchange changes afterwards, need [`Self::pad_velocities`]).
     fn update(&mut self, c: &Coefficients, dt: f32) {
         let wide = wide_lanes();
@@ -777,7 +776,8 @@ impl<const D: usize> Workspace<D> {
         }
     }
 
-    /// In 3D: `vel4` from `vel` (after every change of `vel`, before an error pass reads it).
+    /// In 3D: `vel4` from `vel`, for the halo copies' velocities a halo exchange has changed since the
+    /// update pass wrote it.
     fn pad_velocities(&mut self) {
         if D != 3 {
             return;

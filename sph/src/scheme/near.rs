@@ -23,7 +23,7 @@ const FAR: f32 = 1.0e15;
 #[repr(align(32))]
 struct Pack([[u32; LANES]; 1 << LANES]);
 
-const PACK: Pack = {
+static PACK: Pack = {
     let mut t = [[0u32; LANES]; 1 << LANES];
     let mut m = 0;
     while m < 1 << LANES {
@@ -93,7 +93,7 @@ impl<const D: usize> Room for Near<D> {
 impl<const D: usize> Near<D> {
     /// Selects, among the particles of `rows` (ranges of the arrays `x`, `v`), those closer to `xa` than
     /// √`reach2` (`xa` itself included if it is among them), in order, and pads them to whole blocks.
-    /// `wide`: pack with AVX2 (only where [`super::candidates::wide_lanes`] holds).
+    /// `wide`: pack with AVX2 (where [`super::candidates::wide_lanes`] holds; checked again here).
     #[inline(always)]
     pub fn select(
         &mut self,
@@ -115,8 +115,8 @@ impl<const D: usize> Near<D> {
         }
         let n = {
             #[cfg(target_arch = "x86_64")]
-            if wide && len >= LANES {
-                // SAFETY: `wide` only where the CPU has AVX2 and popcnt; the arrays hold a block, the rows
+            if wide && len >= LANES && super::candidates::wide_lanes() {
+                // SAFETY: the CPU has AVX2 and popcnt (checked just above); the arrays hold a block, the rows
                 // lie within them (asserted above) and every array has room for `total + LANES`
                 // (reserved above).
                 unsafe { self.pack_avx2(xa, reach2, rows, (x, v)) }
