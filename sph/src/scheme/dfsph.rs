@@ -742,8 +742,8 @@ impl<const D: usize> Workspace<D> {
         merged(partials).error as f64
     }
 
-    /// Pass 3 (velocity update) over all particles; in 3D it also refreshes `vel4` (halo copies' velocities, which a halo
-    /// exchange changes afterwards, need [`Self::pad_velocities`]).
+    /// Pass 3 (velocity update) over all particles; in 3D it also refreshes `vel4` (halo copies' velocities,
+    /// which a halo exchange changes afterwards, need [`Self::pad_velocities`]).
     fn update(&mut self, c: &Coefficients, dt: f32) {
         let wide = wide_lanes();
         let Workspace {
