@@ -287,6 +287,23 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
             s.sq[l] += mf * mf * g2;
             hit[l] = inside && r2 > 0.0;
         }
+        #[cfg(target_arch = "x86_64")]
+        if wide && D == 3 && W == 4 {
+            let mask = (0..LANES).fold(0usize, |m, l| m | (hit[l] as usize) << l);
+            // SAFETY: `wide` holds only where the CPU has AVX2; n + LANES ≤ (blk + 1) · LANES ≤ the room
+            // reserved above (n ≤ blk · LANES); D == 3 and W == 4.
+            unsafe {
+                store_block_avx2(
+                    mask,
+                    [&gl[0], &gl[1], &gl[2 % D]],
+                    &idx,
+                    js.as_mut_ptr().add(n).cast(),
+                    gs.as_mut_ptr().add(n).cast(),
+                )
+            };
+            n += mask.count_ones() as usize;
+            continue;
+        }
         for l in 0..LANES {
             js[n].write(idx[l]);
             gs[n].write(std::array::from_fn(|d| if d < D { gl[d][l] } else { 0.0 }));
@@ -338,6 +355,49 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
         wflux: lane_sum(&s.wflux),
         liquid: n as u32,
         walls: lane_sum(&s.walls) as u32,
+    }
+}
+
+/// The lanes of one block of 3D neighbours set in `mask`, packed to the front (one lane permutation,
+/// `near::PACK`), as eight four-lane gradient records (x, y, z, 0) and eight indices, stored whole at `j`
+/// and `g` (what lies beyond the kept lanes is overwritten by the next block or cut off): the same values
+/// in the same order as `hood`'s lane-by-lane writes, in ~20 instructions instead of ~110.
+///
+/// # Safety
+/// The CPU has AVX2; `j` has room for 8 u32 and `g` for 32 f32.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn store_block_avx2(
+    mask: usize,
+    gl: [&[f32; LANES]; 3],
+    idx: &[u32; LANES],
+    j: *mut u32,
+    g: *mut f32,
+) {
+    use std::arch::x86_64::*;
+    // SAFETY: AVX2 (the caller); the loads read whole arrays of 8 lanes, the stores stay within the room
+    // the caller guarantees; the table is 32-byte aligned.
+    unsafe {
+        let perm = _mm256_load_si256(super::near::PACK.0[mask].as_ptr() as *const __m256i);
+        // (No closures here: a closure would not inherit AVX2, and the intrinsics would not be inlined.)
+        let x = _mm256_permutevar8x32_ps(_mm256_loadu_ps(gl[0].as_ptr()), perm);
+        let y = _mm256_permutevar8x32_ps(_mm256_loadu_ps(gl[1].as_ptr()), perm);
+        let z = _mm256_permutevar8x32_ps(_mm256_loadu_ps(gl[2].as_ptr()), perm);
+        let zero = _mm256_setzero_ps();
+        // Per 128-bit half: (x0 y0 x1 y1), (x2 y2 x3 y3), (z0 0 z1 0), (z2 0 z3 0) …
+        let (t0, t1) = (_mm256_unpacklo_ps(x, y), _mm256_unpackhi_ps(x, y));
+        let (t2, t3) = (_mm256_unpacklo_ps(z, zero), _mm256_unpackhi_ps(z, zero));
+        // … then records 0 | 4, 1 | 5, 2 | 6, 3 | 7.
+        let r0 = _mm256_shuffle_ps::<0x44>(t0, t2);
+        let r1 = _mm256_shuffle_ps::<0xEE>(t0, t2);
+        let r2 = _mm256_shuffle_ps::<0x44>(t1, t3);
+        let r3 = _mm256_shuffle_ps::<0xEE>(t1, t3);
+        _mm256_storeu_ps(g, _mm256_permute2f128_ps::<0x20>(r0, r1));
+        _mm256_storeu_ps(g.add(8), _mm256_permute2f128_ps::<0x20>(r2, r3));
+        _mm256_storeu_ps(g.add(16), _mm256_permute2f128_ps::<0x31>(r0, r1));
+        _mm256_storeu_ps(g.add(24), _mm256_permute2f128_ps::<0x31>(r2, r3));
+        let i = _mm256_loadu_si256(idx.as_ptr() as *const __m256i);
+        _mm256_storeu_si256(j as *mut __m256i, _mm256_permutevar8x32_epi32(i, perm));
     }
 }
 
@@ -1159,7 +1219,7 @@ mod tests {
         own: ([f32; D], [f32; D]),
         around: Around<'_, D>,
         wide: bool,
-    ) -> (Hood<D>, Vec<u32>, [f64; D]) {
+    ) -> (Hood<D>, Vec<u32>, [f64; D], Vec<u32>) {
         let (mut j, mut g) = (Vec::new(), Vec::<[f32; W]>::new());
         let (mut fs, mut bs) = (Near::default(), Near::default());
         let near = (&mut fs, &mut bs);
@@ -1177,7 +1237,8 @@ mod tests {
         assert_eq!(g.len(), j.len());
         assert!(g.iter().all(|g| g[D..].iter().all(|x| *x == 0.0)));
         let sum = std::array::from_fn(|d| g.iter().map(|g| g[d] as f64).sum());
-        (s, j, sum)
+        let bits = g.iter().flat_map(|g| g.map(f32::to_bits)).collect();
+        (s, j, sum, bits)
     }
 
     fn check<const D: usize, K: Kernel>() {
@@ -1262,6 +1323,12 @@ mod tests {
             if wide_lanes() {
                 fast.push(listed::<D, D, K>(&k, &c, own, around, true));
                 fast.push(listed::<D, 4, K>(&k, &c, own, around, true));
+                // The AVX2 lists (in 3D with four lanes written by `store_block_avx2`) hold the plain
+                // lists' neighbours and gradients to the bit.
+                let plain = listed::<D, 4, K>(&k, &c, own, around, false);
+                let wide = listed::<D, 4, K>(&k, &c, own, around, true);
+                assert_eq!(plain.1, wide.1, "listed neighbours, plain and AVX2");
+                assert_eq!(plain.3, wide.3, "listed gradients, plain and AVX2");
             }
             let gs = grad
                 .iter()
@@ -1269,7 +1336,7 @@ mod tests {
                 .map(|q| q.abs())
                 .fold(1e-9, f64::max);
             let vs = visc.iter().map(|q| q.abs()).fold(1e-9, f64::max);
-            for (s, j, gsum) in &fast {
+            for (s, j, gsum, _) in &fast {
                 assert!(
                     (s.density as f64 - density).abs() < 1e-5 * density,
                     "density"
