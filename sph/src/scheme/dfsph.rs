@@ -546,6 +546,7 @@ enum Mode {
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn error_chunk<const D: usize, const W: usize>(
+    wide: bool,
     c: &Coefficients,
     mode: Mode,
     dt: f32,
@@ -564,7 +565,7 @@ fn error_chunk<const D: usize, const W: usize>(
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
         // SAFETY: every index in the lists is below `end_j` (asserted above).
         let mut s = c.pair.m_fluid
-            * unsafe { divergence(&lists.j[lo..hi], &g[lo..hi], vel, va) }
+            * unsafe { divergence(&lists.j[lo..hi], &g[lo..hi], vel, va, wide) }
                 .iter()
                 .take(D)
                 .sum::<f32>();
@@ -600,6 +601,7 @@ fn error_chunk<const D: usize, const W: usize>(
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn update_chunk<const D: usize, const W: usize>(
+    wide: bool,
     c: &Coefficients,
     dt: f32,
     (lists, g): (&Lists<D>, &[[f32; W]]),
@@ -617,7 +619,7 @@ fn update_chunk<const D: usize, const W: usize>(
         ksum[o] += ka;
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
         // SAFETY: every index in the lists is below `end_j` (asserted above).
-        let acc = unsafe { push(&lists.j[lo..hi], &g[lo..hi], kall, ka) };
+        let acc = unsafe { push(&lists.j[lo..hi], &g[lo..hi], kall, ka, wide) };
         let gb = lists.gb[o];
         for d in 0..D {
             vel[o][d] -= dt * (c.pair.m_fluid * acc[d] + MIRROR * ka * gb[d]);
@@ -660,7 +662,9 @@ fn error_pass<const D: usize, const W: usize>(
     own: (&[f32], &[f32]),
     k: &mut [f32],
 ) -> Partial {
-    maybe_avx(wide, || error_chunk(c, mode, dt, lists, vel, first, own, k))
+    maybe_avx(wide, || {
+        error_chunk(wide, c, mode, dt, lists, vel, first, own, k)
+    })
 }
 
 /// [`update_chunk`] out of line and with AVX where `wide`, as [`error_pass`].
@@ -676,7 +680,7 @@ fn update_pass<const D: usize, const W: usize>(
     (vel, ksum, vel4): (&mut [[f32; D]], &mut [f32], &mut [[f32; 4]]),
 ) {
     maybe_avx(wide, || {
-        update_chunk(c, dt, lists, kall, first, vel, ksum, vel4)
+        update_chunk(wide, c, dt, lists, kall, first, vel, ksum, vel4)
     })
 }
 

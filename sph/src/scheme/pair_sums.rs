@@ -38,23 +38,35 @@ pub fn pair_sum<const W: usize>(
     std::array::from_fn(|d| (acc[0][d] + acc[1][d]) + (acc[2][d] + acc[3][d]))
 }
 
-/// Σ_b (v_a − v_b) ∇W_ab per lane (the divergence is the sum of its first D lanes).
+/// Σ_b (v_a − v_b) ∇W_ab per lane (the divergence is the sum of its first D lanes); in four lanes two pairs
+/// at a time on 256-bit registers where `wide`.
 ///
 /// # Safety
-/// Every index in `j` is below `vel.len()` (the neighbours' velocities are read unchecked).
+/// Every index in `j` is below `vel.len()` (the neighbours' velocities are read unchecked); `wide` only
+/// where the CPU has AVX.
 #[inline(always)]
 pub unsafe fn divergence<const W: usize>(
     j: &[u32],
     g: &[[f32; W]],
     vel: &[[f32; W]],
     va: [f32; W],
+    wide: bool,
 ) -> [f32; W] {
     #[cfg(target_arch = "x86_64")]
     if W == 4 {
-        // SAFETY: W == 4, so these are the same types; the caller guarantees j < vel.len().
-        let r = unsafe { sse::divergence(j, as4(g), as4(vel), std::array::from_fn(|d| va[d])) };
+        let va = std::array::from_fn(|d| va[d]);
+        // SAFETY: W == 4, so these are the same types; the caller guarantees j < vel.len() and AVX where
+        // `wide`.
+        let r = unsafe {
+            if wide {
+                avx::divergence(j, as4(g), as4(vel), va)
+            } else {
+                sse::divergence(j, as4(g), as4(vel), va)
+            }
+        };
         return std::array::from_fn(|d| r[d]);
     }
+    let _ = wide;
     pair_sum(j, g, |j, g| {
         // SAFETY: the caller guarantees j < vel.len().
         let vb = unsafe { vel.get_unchecked(j as usize) };
@@ -62,18 +74,33 @@ pub unsafe fn divergence<const W: usize>(
     })
 }
 
-/// Σ_b (k_a + k_b) ∇W_ab.
+/// Σ_b (k_a + k_b) ∇W_ab (as [`divergence`] where `wide`).
 ///
 /// # Safety
-/// Every index in `j` is below `k.len()` (the neighbours' k are read unchecked).
+/// Every index in `j` is below `k.len()` (the neighbours' k are read unchecked); `wide` only where the CPU
+/// has AVX.
 #[inline(always)]
-pub unsafe fn push<const W: usize>(j: &[u32], g: &[[f32; W]], k: &[f32], ka: f32) -> [f32; W] {
+pub unsafe fn push<const W: usize>(
+    j: &[u32],
+    g: &[[f32; W]],
+    k: &[f32],
+    ka: f32,
+    wide: bool,
+) -> [f32; W] {
     #[cfg(target_arch = "x86_64")]
     if W == 4 {
-        // SAFETY: W == 4, so these are the same types; the caller guarantees j < k.len().
-        let r = unsafe { sse::push(j, as4(g), k, ka) };
+        // SAFETY: W == 4, so these are the same types; the caller guarantees j < k.len() and AVX where
+        // `wide`.
+        let r = unsafe {
+            if wide {
+                avx::push(j, as4(g), k, ka)
+            } else {
+                sse::push(j, as4(g), k, ka)
+            }
+        };
         return std::array::from_fn(|d| r[d]);
     }
+    let _ = wide;
     pair_sum(j, g, |j, g| {
         // SAFETY: the caller guarantees j < k.len().
         let s = ka + unsafe { k.get_unchecked(j as usize) };
@@ -165,6 +192,132 @@ mod sse {
     }
 }
 
+/// The four-lane sums two pairs at a time: pairs 4n and 4n + 1 share one 256-bit register (the chains 0 and
+/// 1 of [`super::pair_sum`] in its halves), pairs 4n + 2 and 4n + 3 another, so each lane sees the same
+/// additions in the same order as the 128-bit loop and the results are the same to the bit (tested); a
+/// pair of gradients is one 32-byte load, and the arithmetic is half the instructions.
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::CHAINS;
+    use std::arch::x86_64::*;
+
+    /// The chains of [`super::pair_sum`] over `$j`/`$g`: `$two(j0, j1, g01)` gives two pairs' terms from
+    /// their gradients (one 256-bit register), `$one(j, g)` one pair's (the remainder, 128 bits). A macro,
+    /// not closures: a closure would not inherit the function's AVX, and the intrinsics would be calls.
+    macro_rules! chains {
+        ($j:expr, $g:expr, |$j0:ident, $j1:ident, $g2:ident| $two:expr, |$j_:ident, $g1:ident| $one:expr) => {{
+            let (j, g): (&[u32], &[[f32; 4]]) = ($j, $g);
+            let (mut a01, mut a23) = (_mm256_setzero_ps(), _mm256_setzero_ps());
+            let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
+            let (gc, gr) = g.split_at(jc.len());
+            for (js, gs) in jc.chunks_exact(CHAINS).zip(gc.chunks_exact(CHAINS)) {
+                // SAFETY: 32 readable bytes: two consecutive records.
+                let (g01, g23) = unsafe {
+                    (
+                        _mm256_loadu_ps(gs[0].as_ptr()),
+                        _mm256_loadu_ps(gs[2].as_ptr()),
+                    )
+                };
+                let ($j0, $j1, $g2) = (js[0], js[1], g01);
+                a01 = _mm256_add_ps(a01, $two);
+                let ($j0, $j1, $g2) = (js[2], js[3], g23);
+                a23 = _mm256_add_ps(a23, $two);
+            }
+            let mut acc = [
+                _mm256_castps256_ps128(a01),
+                _mm256_extractf128_ps::<1>(a01),
+                _mm256_castps256_ps128(a23),
+                _mm256_extractf128_ps::<1>(a23),
+            ];
+            for (l, (jj, gg)) in jr.iter().zip(gr).enumerate() {
+                // SAFETY: 16 readable bytes.
+                let ($j_, $g1) = (*jj, unsafe { _mm_loadu_ps(gg.as_ptr()) });
+                acc[l] = _mm_add_ps(acc[l], $one);
+            }
+            let mut out = [0.0f32; 4];
+            // SAFETY: 16 writable bytes.
+            unsafe {
+                _mm_storeu_ps(
+                    out.as_mut_ptr(),
+                    _mm_add_ps(_mm_add_ps(acc[0], acc[1]), _mm_add_ps(acc[2], acc[3])),
+                )
+            };
+            out
+        }};
+    }
+
+    /// Records `a` and `b` in the low and high halves of one register.
+    ///
+    /// # Safety
+    /// The CPU has AVX.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    unsafe fn two(a: &[f32; 4], b: &[f32; 4]) -> __m256 {
+        // SAFETY: 16 readable bytes each.
+        unsafe {
+            _mm256_insertf128_ps::<1>(
+                _mm256_castps128_ps256(_mm_loadu_ps(a.as_ptr())),
+                _mm_loadu_ps(b.as_ptr()),
+            )
+        }
+    }
+
+    /// [`super::divergence`], two pairs at a time.
+    ///
+    /// # Safety
+    /// The CPU has AVX; every index in `j` is below `vel.len()`.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    pub(super) unsafe fn divergence(
+        j: &[u32],
+        g: &[[f32; 4]],
+        vel: &[[f32; 4]],
+        va: [f32; 4],
+    ) -> [f32; 4] {
+        // SAFETY: 16 readable bytes.
+        let va1 = unsafe { _mm_loadu_ps(va.as_ptr()) };
+        let va2 = _mm256_set_m128(va1, va1);
+        // SAFETY (the neighbours' velocities): the caller guarantees j < vel.len().
+        chains!(
+            j,
+            g,
+            |j0, j1, g| unsafe {
+                let vb = two(
+                    vel.get_unchecked(j0 as usize),
+                    vel.get_unchecked(j1 as usize),
+                );
+                _mm256_mul_ps(_mm256_sub_ps(va2, vb), g)
+            },
+            |j, g| unsafe {
+                let vb = _mm_loadu_ps(vel.get_unchecked(j as usize).as_ptr());
+                _mm_mul_ps(_mm_sub_ps(va1, vb), g)
+            }
+        )
+    }
+
+    /// [`super::push`], two pairs at a time.
+    ///
+    /// # Safety
+    /// The CPU has AVX; every index in `j` is below `k.len()`.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    pub(super) unsafe fn push(j: &[u32], g: &[[f32; 4]], k: &[f32], ka: f32) -> [f32; 4] {
+        // SAFETY (the neighbours' k): the caller guarantees j < k.len().
+        chains!(
+            j,
+            g,
+            |j0, j1, g| unsafe {
+                let (s0, s1) = (
+                    ka + k.get_unchecked(j0 as usize),
+                    ka + k.get_unchecked(j1 as usize),
+                );
+                _mm256_mul_ps(_mm256_set_m128(_mm_set1_ps(s1), _mm_set1_ps(s0)), g)
+            },
+            |j, g| unsafe { _mm_mul_ps(_mm_set1_ps(ka + k.get_unchecked(j as usize)), g) }
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -188,6 +341,16 @@ mod tests {
         (j, g, vel, k)
     }
 
+    /// The loops a CPU can run: the 128-bit one always, the 256-bit one where it has AVX.
+    fn ways() -> Vec<bool> {
+        let mut w = vec![false];
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            w.push(true);
+        }
+        w
+    }
+
     #[test]
     fn four_lane_sums_equal_the_generic_loop_to_the_bit() {
         // Every remainder of the chains, and an empty list.
@@ -198,23 +361,27 @@ mod tests {
                 let vb = vel[j as usize];
                 std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
             });
-            // SAFETY (here and below): every j < 50, the particles' count.
-            let fast = unsafe { divergence(&j, &g, &vel, va) };
-            assert_eq!(
-                plain.map(f32::to_bits),
-                fast.map(f32::to_bits),
-                "divergence, {len} pairs"
-            );
+            for wide in ways() {
+                // SAFETY (here and below): every j < 50, the particles' count; AVX where `wide`.
+                let fast = unsafe { divergence(&j, &g, &vel, va, wide) };
+                assert_eq!(
+                    plain.map(f32::to_bits),
+                    fast.map(f32::to_bits),
+                    "divergence, {len} pairs, wide {wide}"
+                );
+            }
             let plain = pair_sum(&j, &g, |j, g| {
                 let s = k[7] + k[j as usize];
                 std::array::from_fn(|d| s * g[d])
             });
-            let fast = unsafe { push(&j, &g, &k, k[7]) };
-            assert_eq!(
-                plain.map(f32::to_bits),
-                fast.map(f32::to_bits),
-                "push, {len} pairs"
-            );
+            for wide in ways() {
+                let fast = unsafe { push(&j, &g, &k, k[7], wide) };
+                assert_eq!(
+                    plain.map(f32::to_bits),
+                    fast.map(f32::to_bits),
+                    "push, {len} pairs, wide {wide}"
+                );
+            }
             assert!(len == 0 || plain.iter().any(|x| *x != 0.0));
         }
     }
@@ -228,10 +395,10 @@ mod tests {
         // SAFETY: every j < 50, the particles' count.
         let (d3, d4, p3, p4) = unsafe {
             (
-                divergence(&j, &g3, &vel3, vel3[3]),
-                divergence(&j, &g, &vel, vel[3]),
-                push(&j, &g3, &k, k[7]),
-                push(&j, &g, &k, k[7]),
+                divergence(&j, &g3, &vel3, vel3[3], false),
+                divergence(&j, &g, &vel, vel[3], false),
+                push(&j, &g3, &k, k[7], false),
+                push(&j, &g, &k, k[7], false),
             )
         };
         for d in 0..3 {
