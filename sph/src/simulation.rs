@@ -252,6 +252,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 };
                 (0.6 * full) as u32
             },
+            relaxation: s.dfsph.relaxation as f32,
         };
         let dt_min = if s.dt_min > 0.0 {
             s.dt_min

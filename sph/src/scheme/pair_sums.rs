@@ -4,7 +4,8 @@
 //! [`pair_sum`] is the generic loop; in 3D the lists hold each gradient (and the solver each velocity) in
 //! four lanes, and on x86_64 [`divergence`] and [`push`] run the same additions in the same order on
 //! 128-bit registers: one load per neighbour's velocity and one per gradient instead of three each (the
-//! loops were bound by loads). The results are the same to the bit as [`pair_sum`]'s (tested).
+//! loops were bound by loads), and where the CPU has AVX two neighbours per 256-bit register. The results
+//! are the same to the bit as [`pair_sum`]'s (tested).
 
 /// Independent partial sums a neighbour-list loop keeps, so that consecutive pairs do not wait for each
 /// other's additions (one chain per dimension is bound by the adder's latency, not its throughput).

@@ -23,7 +23,8 @@
 //! falls below hydrostatic (a collapsing dam-break column, free fall) start from its own, lower level, so that
 //! its pressure can keep falling, by (1 − β)/2 = 2.5 % a step at least: with β·k_hyd alone the column held on
 //! to the pressure of earlier steps (the monotone update cannot lower it) and the dam-break front ran 20 %
-//! ahead of the experiment (now 9 %, 8 % with the plain warm start; the test allows 10 %).
+//! ahead of the experiment (then 9 %, 8 % with the plain warm start, and 8 % since the relaxed iterations; the
+//! test allows 10 %).
 //!
 //! Columns are one particle spacing wide (x, and y in 3D), counted from the neighbour grid's corner: on a
 //! sloping surface (a dam-break front) wider columns would take a higher top for all their particles. A
