@@ -568,7 +568,8 @@ fn error_chunk<const D: usize, const W: usize>(
         let a = first + o;
         let va = vel[a];
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
-        // SAFETY: every index in the lists is below `end_j` (asserted above).
+        // SAFETY: every index in the lists is below `end_j` (asserted above); `wide` (from `wide_lanes()`)
+        // only where the CPU has AVX2, so AVX.
         let mut s = c.pair.m_fluid
             * unsafe { divergence(&lists.j[lo..hi], &g[lo..hi], vel, va, wide) }
                 .iter()
@@ -623,7 +624,8 @@ fn update_chunk<const D: usize, const W: usize>(
         let ka = kall[a];
         ksum[o] += ka;
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
-        // SAFETY: every index in the lists is below `end_j` (asserted above).
+        // SAFETY: every index in the lists is below `end_j` (asserted above); `wide` only with AVX, as in
+        // `error_chunk`.
         let acc = unsafe { push(&lists.j[lo..hi], &g[lo..hi], kall, ka, wide) };
         let gb = lists.gb[o];
         for d in 0..D {

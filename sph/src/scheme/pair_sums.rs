@@ -212,11 +212,12 @@ mod avx {
             let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
             let (gc, gr) = g.split_at(jc.len());
             for (js, gs) in jc.chunks_exact(CHAINS).zip(gc.chunks_exact(CHAINS)) {
-                // SAFETY: 32 readable bytes: two consecutive records.
+                // SAFETY: 32 readable bytes: two consecutive records (pointers from the slice, which covers
+                // both).
                 let (g01, g23) = unsafe {
                     (
-                        _mm256_loadu_ps(gs[0].as_ptr()),
-                        _mm256_loadu_ps(gs[2].as_ptr()),
+                        _mm256_loadu_ps(gs[..2].as_ptr().cast()),
+                        _mm256_loadu_ps(gs[2..].as_ptr().cast()),
                     )
                 };
                 let ($j0, $j1, $g2) = (js[0], js[1], g01);
@@ -344,12 +345,11 @@ mod tests {
 
     /// The loops a CPU can run: the 128-bit one always, the 256-bit one where it has AVX.
     fn ways() -> Vec<bool> {
-        let mut w = vec![false];
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx") {
-            w.push(true);
+            return vec![false, true];
         }
-        w
+        vec![false]
     }
 
     #[test]
