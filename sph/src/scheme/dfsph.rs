@@ -43,7 +43,8 @@ use crate::tank::{cross, from3, to3};
 use rayon::prelude::*;
 
 /// How strongly walls push back on a liquid particle with k_i: `MIRROR · m_b k_i ∇W_ib` (1: Akinci et al.'s
-/// boundary term, as SPlisHSPlasH's DFSPH; full pressure mirroring, 2, makes wall particles jitter here).
+/// boundary term, as SPlisHSPlasH's DFSPH; full pressure mirroring, 2, stirs a tank at rest, relaxed
+/// iterations or not).
 pub const MIRROR: f32 = 1.0;
 
 /// Share of the last step's pressure the divergence solve starts from. Each iteration only adds pressure
