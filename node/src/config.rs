@@ -540,13 +540,18 @@ pub fn from_str(
     let src = || source_name.to_string();
     let doc: Value = serde_saphyr::from_str(text).map_err(|e| ConfigError::Yaml {
         source_name: src(),
-        message: e.to_string(),
+        // The parser's hint is for programs using it, not for whoever wrote the file.
+        message: e.to_string().replace(
+            ", set DuplicateKeyPolicy in Options if acceptable",
+            " (each parameter may be given once: remove one)",
+        ),
     })?;
     let mut params = ros_parameters(doc).map_err(|message| ConfigError::Layout {
         source_name: src(),
         message,
     })?;
     for o in overrides {
+        let o = &from_current_dir(o);
         apply_override(&mut params, o).map_err(|(key, message)| ConfigError::Key {
             source_name: src(),
             key,
@@ -588,13 +593,89 @@ fn ros_parameters(doc: Value) -> Result<Value, String> {
     let (node, body) = top.into_iter().next().unwrap();
     match body {
         Value::Object(mut m) => match m.remove("ros__parameters") {
-            Some(p @ Value::Object(_)) if m.is_empty() => Ok(p),
+            Some(p @ Value::Object(_)) if m.is_empty() => nested(p, ""),
             Some(_) if !m.is_empty() => Err(format!("{node}: only `ros__parameters` may sit under the node name, found {:?}", m.keys().collect::<Vec<_>>())),
             Some(_) => Err(format!("{node}.ros__parameters: expected a map of parameters")),
             None => Err(format!("{node}: missing `ros__parameters:` (the ROS 2 parameters layout is `{node}: {{ros__parameters: {{...}}}}`)")),
         },
         _ => Err(format!("{node}: expected `ros__parameters:` under the node name")),
     }
+}
+
+/// A `motion.file=PATH` override with a relative PATH made absolute from the current folder (where the user
+/// typed it; a config file's own `motion.file` is relative to the file's folder); other overrides as they are.
+fn from_current_dir(o: &str) -> String {
+    if let Some((key, value)) = o.split_once('=') {
+        let v = value.trim();
+        if key.trim() == "motion.file" && !v.is_empty() && Path::new(v).is_relative() {
+            if let Ok(here) = std::env::current_dir() {
+                // Quoted as YAML, so that the path stays one string whatever its characters.
+                let abs = here.join(v).display().to_string();
+                return format!("{key}={}", serde_json::Value::String(abs));
+            }
+        }
+    }
+    o.to_string()
+}
+
+/// The parameter tree with dotted names (`tank.length: 0.8`, as ROS 2 parameter files may write them) nested
+/// as groups (`tank: {length: 0.8}`); a parameter given both ways is an error naming it.
+fn nested(v: Value, prefix: &str) -> Result<Value, String> {
+    let Value::Object(m) = v else {
+        return Ok(v);
+    };
+    let mut out = Map::new();
+    for (key, value) in m {
+        let full = if prefix.is_empty() {
+            key.clone()
+        } else {
+            format!("{prefix}.{key}")
+        };
+        let value = nested(value, &full)?;
+        let mut parts = key.split('.').peekable();
+        let mut node = &mut out;
+        let mut path = prefix.to_string();
+        while let Some(part) = parts.next() {
+            if part.is_empty() {
+                return Err(format!("{full}: empty parameter name"));
+            }
+            path = if path.is_empty() {
+                part.to_string()
+            } else {
+                format!("{path}.{part}")
+            };
+            if parts.peek().is_none() {
+                match (node.get_mut(part), value) {
+                    (Some(Value::Object(have)), Value::Object(add)) => {
+                        for (k, v) in add {
+                            if have.insert(k.clone(), v).is_some() {
+                                return Err(format!(
+                                    "{path}.{k}: given twice (as a dotted name and in its group)"
+                                ));
+                            }
+                        }
+                    }
+                    (Some(_), _) => {
+                        return Err(format!(
+                            "{path}: given twice (as a dotted name and in its group)"
+                        ))
+                    }
+                    (None, value) => {
+                        node.insert(part.to_string(), value);
+                    }
+                }
+                break;
+            }
+            let next = node
+                .entry(part.to_string())
+                .or_insert_with(|| Value::Object(Map::new()));
+            let Value::Object(next) = next else {
+                return Err(format!("{path}: is a value, not a group of parameters"));
+            };
+            node = next;
+        }
+    }
+    Ok(Value::Object(out))
 }
 
 /// Applies `a.b.c=value` (value parsed as YAML) to the parameter tree.
@@ -748,6 +829,7 @@ impl Loaded {
         };
         p.validate()
             .map_err(|e| key_err(src, &e.field, e.message))?;
+        crate::memory::check(&p).map_err(|m| key_err(src, "particle_spacing", m))?;
         if !(c.output_rate_hz.is_finite() && c.output_rate_hz > 0.0) {
             return Err(key_err(
                 src,
@@ -913,6 +995,13 @@ mod tests {
             err(MIN, &["output_rate_hz=0"]).contains("output_rate_hz: must be a positive number")
         );
         assert!(err(MIN, &["tank.length=-1"]).contains("tank.length: must be a positive number"));
+        // A spacing typed 1000× too fine: refused before anything is allocated.
+        let e = err(MIN, &["particle_spacing=1e-5"]);
+        assert!(
+            e.contains("case.yaml: particle_spacing: 0.00001 m makes about")
+                && e.contains("use a spacing of at least"),
+            "{e}"
+        );
         assert!(err(MIN, &["solver"]).contains("an override must look like key.sub=value"));
         assert!(err("slosh: {}\n", &[]).contains("missing `ros__parameters:`"));
         assert!(
@@ -922,6 +1011,47 @@ mod tests {
         assert!(
             err("slosh:\n  ros__parameters:\n    dimension: [\n", &[]).contains("not valid YAML")
         );
+        let e = err(&format!("{MIN}    dimension: 3\n"), &[]);
+        assert!(
+            e.contains("duplicate mapping key: dimension (each parameter may be given once")
+                && !e.contains("DuplicateKeyPolicy"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_motion_file_given_on_the_command_line_is_relative_to_the_current_folder() {
+        let dir = std::env::temp_dir().join(format!("slosh-config-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("case.yaml");
+        std::fs::write(
+            &file,
+            format!("{MIN}    motion: {{source: csv, file: m.csv}}\n"),
+        )
+        .unwrap();
+        let cfg = file.display().to_string();
+        let l = load(&cfg, &[]).unwrap();
+        assert_eq!(l.motion_file().unwrap(), dir.join("m.csv"));
+        let l = load(&cfg, &["motion.file=data/my motion.csv".into()]).unwrap();
+        let here = std::env::current_dir().unwrap();
+        assert_eq!(l.motion_file().unwrap(), here.join("data/my motion.csv"));
+        let l = load(&cfg, &["motion.file=/abs/m.csv".into()]).unwrap();
+        assert_eq!(l.motion_file().unwrap(), PathBuf::from("/abs/m.csv"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn dotted_names_in_a_parameter_file_are_groups() {
+        let text = "slosh:\n  ros__parameters:\n    dimension: 2\n    tank.length: 0.8\n    tank: {breadth: 0.25, height: 0.6}\n    fill_height: 0.39\n    particle_spacing: 0.02\n    solver.dfsph.cfl: 0.3\n";
+        let l = from_str(text, "case.yaml", None, &[]).unwrap();
+        let p = l.sim_params().unwrap();
+        assert_eq!((p.tank.length, p.tank.breadth), (0.8, 0.25));
+        assert_eq!(p.solver.dfsph.cfl, 0.3);
+        let twice = text.replace("{breadth: 0.25", "{length: 0.7, breadth: 0.25");
+        let e = err(&twice, &[]);
+        assert!(e.contains("tank.length: given twice"), "{e}");
+        let e = err(&text.replace("solver.dfsph.cfl", "solver.dfsph.cfll"), &[]);
+        assert!(e.contains("solver.dfsph.cfll: unknown field"), "{e}");
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! The `slosh` command's library: configuration, motion sources, the offline runner, outputs and benchmarks.
+//! The `slosh` command's library: configuration, motion sources, the offline runner, outputs and benchmarks,
 //! and the ROS 2 node and motion publisher (`ros`); the binary stays a thin layer over these modules.
 // Component loops over the const-generic dimension read as the formulas do; `!(x >= 0.0)` is used on purpose
 // to catch NaN along with negatives.
@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod config;
 pub mod iox;
+pub mod memory;
 pub mod motion_source;
 pub mod output;
 pub mod plot;

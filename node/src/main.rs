@@ -267,6 +267,21 @@ enum BagCommand {
 }
 
 /// A path beside `bag` named after it with `suffix` (`runs/ship1` → `runs/ship1_replay`).
+/// The output files a run wrote into `out`, as `out/{a.csv, b.csv, ...}`.
+fn outputs(out: &std::path::Path) -> String {
+    let written: Vec<&str> = [
+        "probes.csv",
+        "wrench.csv",
+        "pressure.csv",
+        "bodies.csv",
+        "summary.json",
+    ]
+    .into_iter()
+    .filter(|f| out.join(f).exists())
+    .collect();
+    format!("{}/{{{}}}", out.display(), written.join(", "))
+}
+
 fn beside(bag: &std::path::Path, suffix: &str) -> PathBuf {
     let name = bag
         .file_stem()
@@ -275,8 +290,19 @@ fn beside(bag: &std::path::Path, suffix: &str) -> PathBuf {
     bag.with_file_name(format!("{name}{suffix}"))
 }
 
-fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
+/// Errors are the user's to act on: printed as one line of causes (`a: b: c`), never with a backtrace (even
+/// where `RUST_BACKTRACE` is set; panics keep theirs), exit status 1.
+fn main() -> std::process::ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("Error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
     // Under mpirun every rank runs this binary: rank 0 goes on with the command (its simulations spread
     // over all ranks), the others follow its solver calls until it is done.
     #[cfg(feature = "mpi")]
@@ -302,9 +328,11 @@ fn main() -> anyhow::Result<()> {
             let out = out.unwrap_or_else(|| beside(&bag, "_repaired"));
             let r = slosh_node::record::repair(&bag, &out)?;
             println!(
-                "recovered {} messages on {} topics into {}{}",
+                "recovered {} messages on {} topics from {} file{} into {}{}",
                 r.messages,
                 r.topics,
+                r.files,
+                if r.files == 1 { "" } else { "s" },
                 out.display(),
                 r.stopped
                     .map(|e| format!(" (the input ends early: {e})"))
@@ -389,10 +417,7 @@ fn main() -> anyhow::Result<()> {
                 "done: {} s simulated in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s, {} liquid + {} boundary particles, {} lost)",
                 s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s, s.particles_fluid, s.particles_boundary, s.particles_lost
             );
-            println!(
-                "outputs: {}/{{probes.csv, wrench.csv, pressure.csv, summary.json}}",
-                out.display()
-            );
+            println!("outputs: {}", outputs(&out));
         }
         Command::Replay {
             bag,
@@ -429,10 +454,7 @@ fn main() -> anyhow::Result<()> {
                 "done: {} s replayed in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s)",
                 s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s
             );
-            println!(
-                "outputs: {}/{{probes.csv, wrench.csv, pressure.csv, summary.json}}",
-                out.display()
-            );
+            println!("outputs: {}", outputs(&out));
         }
         Command::Couple {
             config: cfg,

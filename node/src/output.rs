@@ -23,10 +23,9 @@ pub const BODY_COLUMNS: &str =
 
 fn create(dir: &Path, name: &str, header: &str) -> std::io::Result<BufWriter<File>> {
     let path = dir.join(name);
-    let mut w = BufWriter::new(
-        File::create(&path)
-            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?,
-    );
+    let mut w = BufWriter::new(File::create(&path).map_err(|e| {
+        std::io::Error::new(e.kind(), format!("{}: cannot create: {e}", path.display()))
+    })?);
     writeln!(w, "{header}")?;
     Ok(w)
 }
@@ -34,8 +33,15 @@ fn create(dir: &Path, name: &str, header: &str) -> std::io::Result<BufWriter<Fil
 impl CsvOutputs {
     /// Creates the folder and the three CSV files with their headers.
     pub fn create(dir: &Path, params: &SimParams) -> std::io::Result<Self> {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
+        std::fs::create_dir_all(dir).map_err(|e| {
+            std::io::Error::new(
+                e.kind(),
+                format!(
+                    "output folder (--out) {}: cannot create it: {e}",
+                    dir.display()
+                ),
+            )
+        })?;
         let names = |v: Vec<&str>| {
             std::iter::once("time")
                 .chain(v)

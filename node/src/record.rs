@@ -22,6 +22,39 @@ pub struct RecordCfg {
     pub compression: String,
     /// Bytes of messages per chunk.
     pub chunk_size: u64,
+    /// Who chose `path` (for the error messages): `record.path`, or a command's output folder.
+    #[serde(skip)]
+    pub chosen_by: ChosenBy,
+}
+
+/// Where a bag's folder was chosen, which is what an error about it must name, with the fix.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub enum ChosenBy {
+    /// The case's `record.path`.
+    #[default]
+    RecordPath,
+    /// `slosh replay`'s output folder (its new bag goes to OUT/bag).
+    ReplayOut,
+    /// `slosh bag repair --out`.
+    RepairOut,
+}
+
+impl ChosenBy {
+    fn label(self) -> &'static str {
+        match self {
+            Self::RecordPath => "record.path",
+            Self::ReplayOut => "the replay's new bag (OUT/bag)",
+            Self::RepairOut => "the repaired bag (--out)",
+        }
+    }
+
+    fn choose_another(self) -> &'static str {
+        match self {
+            Self::RecordPath => "choose a new folder for record.path",
+            Self::ReplayOut => "choose another --out (or set record.path)",
+            Self::RepairOut => "choose another --out",
+        }
+    }
 }
 
 impl Default for RecordCfg {
@@ -30,14 +63,21 @@ impl Default for RecordCfg {
             path: String::new(),
             compression: "zstd".into(),
             chunk_size: 768 * 1024,
+            chosen_by: ChosenBy::RecordPath,
         }
     }
 }
 
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
-    #[error("record.path {path}: {message}")]
-    Path { path: String, message: String },
+    /// The bag folder (or, for `bag repair`, the damaged input) cannot be used; `what` names where it was
+    /// given.
+    #[error("{what} {path}: {message}")]
+    Path {
+        what: &'static str,
+        path: String,
+        message: String,
+    },
     #[error("record.compression: `{0}` is not one of `zstd`, `none`")]
     Compression(String),
     #[error("recording to {path}: {message}")]
@@ -89,6 +129,7 @@ impl Recorder {
     pub fn create(cfg: &RecordCfg, parameters: &serde_json::Value) -> Result<Self, RecordError> {
         let dir = PathBuf::from(&cfg.path);
         let err = |message: String| RecordError::Path {
+            what: cfg.chosen_by.label(),
             path: cfg.path.clone(),
             message,
         };
@@ -102,10 +143,10 @@ impl Recorder {
                 .map(|mut d| d.next().is_some())
                 .unwrap_or(true)
         {
-            return Err(err(
-                "already exists and is not empty: choose a new folder (a bag is never overwritten)"
-                    .into(),
-            ));
+            return Err(err(format!(
+                "already exists and is not empty: {} (a bag is never overwritten)",
+                cfg.chosen_by.choose_another()
+            )));
         }
         std::fs::create_dir_all(&dir).map_err(|e| err(format!("cannot create the folder: {e}")))?;
         let stem = dir
@@ -310,63 +351,74 @@ pub fn output_topics() -> [String; 3] {
 pub struct Repaired {
     pub messages: u64,
     pub topics: usize,
+    /// MCAP files read.
+    pub files: usize,
     /// Why reading stopped before a proper end, if it did.
     pub stopped: Option<String>,
 }
 
-/// Makes a whole bag from a damaged or unfinished MCAP (a bag folder or the file): every message of the
-/// complete chunks, up to the first damaged record, is written to a new bag folder `out`.
+/// Makes a whole bag from a damaged or unfinished MCAP bag (a bag folder, split or not, or one `.mcap`
+/// file): every message of the complete chunks of each file, up to its first damaged record, is written in
+/// order to a new bag folder `out`. A file that is not MCAP at all is an error (nothing is written).
 pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
-    let file = if input.is_dir() {
-        std::fs::read_dir(input)
-            .ok()
-            .and_then(|d| {
-                d.filter_map(|e| e.ok().map(|e| e.path()))
-                    .find(|p| p.extension().is_some_and(|x| x == "mcap"))
-            })
-            .ok_or_else(|| RecordError::Path {
-                path: input.display().to_string(),
-                message: "no .mcap file in this folder".into(),
-            })?
-    } else {
-        input.to_path_buf()
+    let bad = |path: &Path, message: String| RecordError::Path {
+        what: "bag",
+        path: path.display().to_string(),
+        message,
     };
-    let bytes = std::fs::read(&file).map_err(|e| RecordError::Path {
-        path: file.display().to_string(),
-        message: format!("cannot read: {e}"),
-    })?;
-    let stream =
-        mcap::MessageStream::new_with_options(&bytes, mcap::read::Options::IgnoreEndMagic.into())
-            .map_err(|e| RecordError::Path {
-            path: file.display().to_string(),
-            message: format!("not an MCAP file: {e}"),
-        })?;
+    let files = repair_inputs(input).map_err(|m| bad(input, m))?;
+    let mut contents = Vec::with_capacity(files.len());
+    for file in &files {
+        let bytes = std::fs::read(file).map_err(|e| bad(file, format!("cannot read: {e}")))?;
+        if !bytes.starts_with(mcap::MAGIC) {
+            return Err(bad(
+                file,
+                format!(
+                    "not an MCAP file (it does not start with the MCAP magic bytes; {} bytes long)",
+                    bytes.len()
+                ),
+            ));
+        }
+        contents.push(bytes);
+    }
     let cfg = RecordCfg {
         path: out.display().to_string(),
+        chosen_by: ChosenBy::RepairOut,
         ..Default::default()
     };
     let mut rec = Recorder::create(
         &cfg,
-        &serde_json::json!({"repaired_from": file.display().to_string()}),
+        &serde_json::json!({"repaired_from": input.display().to_string()}),
     )?;
     let mut n = 0;
-    let mut stopped = None;
-    for m in stream {
-        match m {
-            Ok(m) => {
-                let (name, schema) = match &m.channel.schema {
-                    Some(s) => (
-                        s.name.clone(),
-                        String::from_utf8_lossy(&s.data).into_owned(),
-                    ),
-                    None => (String::new(), String::new()),
-                };
-                rec.write_raw(&m.channel.topic, &name, &schema, m.log_time, &m.data)?;
-                n += 1;
-            }
-            Err(e) => {
-                stopped = Some(e.to_string());
-                break;
+    let mut stops = Vec::new();
+    for (file, bytes) in files.iter().zip(&contents) {
+        let stream = mcap::MessageStream::new_with_options(
+            bytes,
+            mcap::read::Options::IgnoreEndMagic.into(),
+        )
+        .map_err(|e| bad(file, format!("not an MCAP file: {e}")))?;
+        for m in stream {
+            match m {
+                Ok(m) => {
+                    let (name, schema) = match &m.channel.schema {
+                        Some(s) => (
+                            s.name.clone(),
+                            String::from_utf8_lossy(&s.data).into_owned(),
+                        ),
+                        None => (String::new(), String::new()),
+                    };
+                    rec.write_raw(&m.channel.topic, &name, &schema, m.log_time, &m.data)?;
+                    n += 1;
+                }
+                Err(e) => {
+                    stops.push(if files.len() > 1 {
+                        format!("{}: {e}", file.display())
+                    } else {
+                        e.to_string()
+                    });
+                    break;
+                }
             }
         }
     }
@@ -375,6 +427,136 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
     Ok(Repaired {
         messages: n,
         topics,
-        stopped,
+        files: files.len(),
+        stopped: (!stops.is_empty()).then(|| stops.join("; ")),
     })
+}
+
+/// The MCAP files to repair, in order: the one file given; a bag folder's files in the order its
+/// `metadata.yaml` lists them; without a readable `metadata.yaml` (a recording killed before it wrote one),
+/// the folder's `.mcap` files in the order rosbag2 numbers them (`NAME_0.mcap`, `NAME_1.mcap`, ...).
+fn repair_inputs(input: &Path) -> Result<Vec<PathBuf>, String> {
+    if !input.exists() {
+        return Err("no such file or folder (give a bag folder or an .mcap file)".into());
+    }
+    if input.is_file() {
+        return Ok(vec![input.to_path_buf()]);
+    }
+    if let Ok(files) = crate::replay::bag::files(input) {
+        return Ok(files);
+    }
+    let mut mcaps: Vec<PathBuf> = std::fs::read_dir(input)
+        .map_err(|e| format!("cannot list: {e}"))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+        .collect();
+    if mcaps.is_empty() {
+        return Err("no .mcap file in this folder".into());
+    }
+    // rosbag2's split files end in _<index>: order by that number, then by name.
+    let index = |p: &PathBuf| {
+        p.file_stem()
+            .and_then(|s| s.to_str())
+            .and_then(|s| s.rsplit_once('_'))
+            .and_then(|(_, i)| i.parse::<u64>().ok())
+            .unwrap_or(u64::MAX)
+    };
+    mcaps.sort_by(|a, b| index(a).cmp(&index(b)).then_with(|| a.cmp(b)));
+    Ok(mcaps)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use slosh_msgs::geometry_msgs::Vector3;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("slosh-record-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// A finished bag in `dir` with one /v message per time in `times` (x = the time).
+    fn bag(dir: &Path, times: &[i32]) -> PathBuf {
+        let cfg = RecordCfg {
+            path: dir.display().to_string(),
+            ..Default::default()
+        };
+        let mut r = Recorder::create(&cfg, &serde_json::json!({})).unwrap();
+        for &t in times {
+            let v = Vector3 {
+                x: t as f64,
+                y: 0.0,
+                z: 0.0,
+            };
+            r.write("/v", Time { sec: t, nanosec: 0 }, &v).unwrap();
+        }
+        r.finish().unwrap();
+        dir.join(format!(
+            "{}_0.mcap",
+            dir.file_name().unwrap().to_string_lossy()
+        ))
+    }
+
+    /// The log times (s) of the messages of the MCAP files of the bag folder `dir`, read by the `mcap` crate.
+    fn times(dir: &Path) -> Vec<u64> {
+        let mut out = Vec::new();
+        for f in crate::replay::bag::files(dir).unwrap() {
+            let bytes = std::fs::read(f).unwrap();
+            for m in mcap::MessageStream::new(&bytes).unwrap() {
+                out.push(m.unwrap().log_time / 1_000_000_000);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn repair_refuses_a_file_that_is_not_mcap() {
+        let d = tmp("not-mcap");
+        for (name, content) in [("text.mcap", &b"hello, not a bag"[..]), ("empty.mcap", b"")] {
+            let f = d.join(name);
+            std::fs::write(&f, content).unwrap();
+            let out = d.join(format!("{name}_repaired"));
+            let e = repair(&f, &out).unwrap_err().to_string();
+            assert!(
+                e.starts_with("bag ") && e.contains("not an MCAP file"),
+                "{e}"
+            );
+            assert!(!out.exists(), "nothing written for {name}");
+        }
+        let e = repair(&d.join("missing.mcap"), &d.join("x"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing.mcap: no such file or folder"), "{e}");
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn repair_reads_every_file_of_a_split_bag_in_order() {
+        let d = tmp("split");
+        // Three files of a killed split recording (no metadata.yaml), numbered as rosbag2 does: _10 after _2.
+        let split = d.join("split");
+        std::fs::create_dir_all(&split).unwrap();
+        for (i, ts) in [(0, &[1, 2][..]), (2, &[3, 4, 5]), (10, &[6])] {
+            let f = bag(&d.join(format!("part{i}")), ts);
+            std::fs::rename(f, split.join(format!("split_{i}.mcap"))).unwrap();
+        }
+        // The last file cut short inside its summary: its messages are still whole.
+        let last = split.join("split_10.mcap");
+        let len = std::fs::metadata(&last).unwrap().len();
+        let bytes = std::fs::read(&last).unwrap();
+        std::fs::write(&last, &bytes[..len as usize - 20]).unwrap();
+        let out = d.join("repaired");
+        let r = repair(&split, &out).unwrap();
+        assert_eq!((r.messages, r.topics, r.files), (6, 1, 3), "{r:?}");
+        assert_eq!(times(&out), vec![1, 2, 3, 4, 5, 6]);
+        // A second repair into the same folder is refused, naming the option to change.
+        let e = repair(&split, &out).unwrap_err().to_string();
+        assert!(
+            e.contains("the repaired bag (--out)") && e.contains("choose another --out"),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(&d);
+    }
 }

@@ -277,6 +277,12 @@ fn draw(
 
 /// Renders the frames of the run (or snapshot folder) `dir`.
 pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered, String> {
+    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 100.0) {
+        return Err(format!(
+            "--fps {}: must be more than 0 and at most 100 frames per second",
+            opts.fps
+        ));
+    }
     register_font();
     let (series_path, run) = series(dir)?;
     let list = pvd::read(&series_path)?;
@@ -284,12 +290,6 @@ pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered, String> {
         return Err(format!(
             "{}: the series lists no frames (did the run stop before its first snapshot?)",
             series_path.display()
-        ));
-    }
-    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 100.0) {
-        return Err(format!(
-            "--fps {}: between 0 and 100 frames per second, please",
-            opts.fps
         ));
     }
     let f = facts(&run);
@@ -336,6 +336,15 @@ pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered, String> {
     );
     let out = opts.out.clone().unwrap_or_else(|| run.join("render"));
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    // The pictures of an earlier render into the same folder (perhaps of more frames) would be taken for
+    // this run's.
+    for old in std::fs::read_dir(&out).map_err(|e| format!("{}: {e}", out.display()))? {
+        let p = old.map_err(|e| format!("{}: {e}", out.display()))?.path();
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with("frame_") && name.ends_with(".png") {
+            std::fs::remove_file(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+        }
+    }
     let (w, h) = opts.size;
     let gif_path = out.join("run.gif");
     let gif_file =

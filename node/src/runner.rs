@@ -18,14 +18,20 @@ pub enum RunError {
     Config(#[from] crate::config::ConfigError),
     #[error(transparent)]
     Motion(#[from] motion_source::MotionError),
-    #[error("{0}")]
+    #[error(transparent)]
     Output(#[from] std::io::Error),
     #[error(transparent)]
     Record(#[from] RecordError),
     #[error(
-        "interrupted at t = {time:.4} s; outputs so far (and the recording, finished) are in {dir}"
+        "interrupted at t = {time:.4} s; outputs so far are in {dir}{}",
+        .recording.as_ref().map(|r| format!(", the recording (finished) in {r}")).unwrap_or_default()
     )]
-    Interrupted { time: f64, dir: String },
+    Interrupted {
+        time: f64,
+        dir: String,
+        /// The bag's folder, if the run recorded one.
+        recording: Option<String>,
+    },
     #[error("solver stopped: {error} (outputs up to t = {time:.4} s are in {dir})")]
     Solver {
         error: sph::SimError,
@@ -101,10 +107,21 @@ pub fn drive(
         .into());
     }
     if duration > motion.end_time() {
+        let end = motion.end_time();
+        let (source_name, fix) = match opts.duration {
+            Some(_) => (
+                "--duration".to_string(),
+                format!("ask for at most {end:.3} s"),
+            ),
+            None => (
+                cfg.source_name.clone(),
+                format!("set `duration` to at most {end:.3} s or pass a shorter --duration"),
+            ),
+        };
         return Err(crate::config::ConfigError::Key {
-            source_name: cfg.source_name.clone(),
+            source_name,
             key: "duration".into(),
-            message: format!("the motion ends at t = {:.3} s, before the requested duration of {duration} s: shorten --duration", motion.end_time()),
+            message: format!("the motion ends at t = {end:.3} s, before the requested duration of {duration} s: {fix}"),
         }
         .into());
     }
@@ -131,8 +148,13 @@ pub fn drive(
             .into());
         }
     }
+    // The case as run: `--duration` (or a replay's span) in place of the config's.
+    let mut parameters = cfg.parameters.clone();
+    if let Some(p) = parameters.as_object_mut() {
+        p.insert("duration".into(), duration.into());
+    }
     let mut record = match d.record {
-        Some((rc, f)) => Some((Recorder::create(&rc, &cfg.parameters)?, f)),
+        Some((rc, f)) => Some((Recorder::create(&rc, &parameters)?, f)),
         None => None,
     };
     let mut outputs = CsvOutputs::create(out, &params)?;
@@ -169,6 +191,7 @@ pub fn drive(
     // The CSVs are flushed and the bag finished on every path, also when the solver stopped; the first
     // failure is the one reported (a bag that failed to write usually fails to finish too).
     let flushed = outputs.flush();
+    let recording = record.as_ref().map(|(r, _)| r.dir().display().to_string());
     let finished = record.map_or(Ok(()), |(mut r, _)| r.finish());
     let snapshot_info = snapshots.map(|(w, hz)| {
         let (dir, frame) = (w.dir().to_path_buf(), w.frame());
@@ -223,7 +246,7 @@ pub fn drive(
                 "retried_steps": stats.retried_steps,
             })
         }),
-        parameters: cfg.parameters.clone(),
+        parameters,
     };
     write_summary(out, &summary)?;
     match result {
@@ -238,6 +261,7 @@ pub fn drive(
         Err(LoopError::Interrupted(t)) => Err(RunError::Interrupted {
             time: t,
             dir: out.display().to_string(),
+            recording,
         }),
     }
 }

@@ -66,6 +66,9 @@ fn run_writes_the_documented_outputs() {
     }
     assert_eq!(s["dimension"], 2);
     assert!(s["sim_time_s"].as_f64().unwrap() >= 0.2);
+    // The case as run: --duration in place of the file's 20 s.
+    assert_eq!(s["parameters"]["duration"], 0.2);
+    assert_eq!(s["parameters"]["particle_spacing"], 0.02);
     assert!(s["error"].is_null());
     let _ = std::fs::remove_dir_all(&out);
 }

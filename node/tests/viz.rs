@@ -373,7 +373,10 @@ fn snapshots_leave_the_outputs_unchanged_read_in_meshio_and_render() {
         );
     }
 
-    // Pictures: a PNG per frame and an animated GIF of all frames.
+    // Pictures: a PNG per frame and an animated GIF of all frames (a picture an earlier render of more
+    // frames left in the folder is removed).
+    std::fs::create_dir_all(snap.join("render")).unwrap();
+    std::fs::write(snap.join("render/frame_000009.png"), b"stale").unwrap();
     let o = slosh()
         .args(["render"])
         .arg(&snap)
@@ -385,6 +388,7 @@ fn snapshots_leave_the_outputs_unchanged_read_in_meshio_and_render() {
     let last = image(&snap.join("render/frame_000006.png"));
     assert_eq!(first.dimensions(), (320, 240));
     assert!(!snap.join("render/frame_000007.png").exists());
+    assert!(!snap.join("render/frame_000009.png").exists());
     let (share, colours) = ink(&first);
     assert!(
         share > 0.05 && colours > 10,

@@ -297,6 +297,10 @@ pub struct ParamError {
     pub message: String,
 }
 
+/// The most particles (liquid and walls) a case may start with: particle indices are 32-bit with one bit
+/// marking halo copies across ranks.
+pub const MAX_PARTICLES: f64 = (1u64 << 31) as f64;
+
 fn err(field: &str, message: impl Into<String>) -> ParamError {
     ParamError {
         field: field.to_string(),
@@ -355,6 +359,26 @@ impl SimParams {
         } else {
             (2.0 * self.solver.smoothing_ratio).ceil() as u32
         }
+    }
+
+    /// About how many liquid and tank-wall particles the case starts with (the liquid block and the wall
+    /// layers around the tank; bodies not counted), before anything is allocated: what
+    /// [`SimParams::validate`] and a caller's memory check go by.
+    pub fn estimated_particles(&self) -> (f64, f64) {
+        let dp = self.particle_spacing;
+        let across = |len: f64| (len / dp).ceil().max(1.0);
+        let wall = 2.0 * self.wall_layers() as f64;
+        let (mut liquid, mut inner, mut outer) = (
+            across(self.fill_length()) * across(self.fill.height),
+            across(self.tank.length) * across(self.tank.height),
+            (across(self.tank.length) + wall) * (across(self.tank.height) + wall),
+        );
+        if self.dimension == 3 {
+            liquid *= across(self.tank.breadth);
+            inner *= across(self.tank.breadth);
+            outer *= across(self.tank.breadth) + wall;
+        }
+        (liquid, outer - inner)
     }
 
     /// The names of the moving bodies in the order observations list them: the floating bodies, then
@@ -528,6 +552,19 @@ impl SimParams {
                 "particle_spacing",
                 format!(
                     "{dp} m is too coarse for the tank: use at most a quarter of its smallest side"
+                ),
+            ));
+        }
+        let (liquid, walls) = self.estimated_particles();
+        if liquid + walls > MAX_PARTICLES {
+            // The solver indexes particles with 32 bits (one of them a flag).
+            let finest = dp * ((liquid + walls) / MAX_PARTICLES).powf(1.0 / self.dimension as f64);
+            return Err(err(
+                "particle_spacing",
+                format!(
+                    "{dp} m makes about {:.1e} particles, more than the solver can index ({MAX_PARTICLES:.1e}): use a spacing of at least {:.2e} m",
+                    liquid + walls,
+                    finest
                 ),
             ));
         }

@@ -105,6 +105,7 @@ pub fn replay(
     let record_cfg = if c.record.path.is_empty() {
         RecordCfg {
             path: out.join("bag").display().to_string(),
+            chosen_by: crate::record::ChosenBy::ReplayOut,
             ..c.record.clone()
         }
     } else {
