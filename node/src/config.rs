@@ -837,6 +837,13 @@ impl Loaded {
                 format!("must be a positive number, got {}", c.output_rate_hz),
             ));
         }
+        if !matches!(c.record.compression.as_str(), "zstd" | "none" | "") {
+            return Err(key_err(
+                src,
+                "record.compression",
+                format!("`{}` is not one of `zstd`, `none`", c.record.compression),
+            ));
+        }
         if !(c.duration.is_finite() && c.duration > 0.0) {
             return Err(key_err(
                 src,
@@ -995,6 +1002,8 @@ mod tests {
             err(MIN, &["output_rate_hz=0"]).contains("output_rate_hz: must be a positive number")
         );
         assert!(err(MIN, &["tank.length=-1"]).contains("tank.length: must be a positive number"));
+        assert!(err(MIN, &["record.compression=lz4"])
+            .contains("case.yaml: record.compression: `lz4` is not one of `zstd`, `none`"));
         // A spacing typed 1000× too fine: refused before anything is allocated.
         let e = err(MIN, &["particle_spacing=1e-5"]);
         assert!(
