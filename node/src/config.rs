@@ -316,6 +316,10 @@ pub struct RunConfig {
     /// Diagnostics messages per wall-clock second (`slosh node`).
     #[serde(default = "default_diag_rate")]
     pub diagnostics_rate_hz: f64,
+    /// ROS 2's standard parameter (launch files set it on every node): `true` takes the time from `/clock`,
+    /// i.e. `realtime.mode` `follow_clock` unless it is `lockstep` (which publishes `/clock` itself).
+    #[serde(default)]
+    pub use_sim_time: bool,
     /// iceoryx2 services of `slosh node` beside (or instead of) DDS.
     #[serde(default)]
     pub iceoryx2: Iceoryx2Cfg,
@@ -415,6 +419,10 @@ pub struct InputCfg {
     pub max_speed: f64,
     /// rad/s: likewise for each angle.
     pub max_rotation_rate: f64,
+    /// s: a sample stamped more than this after the newest one is rejected (a garbled stamp would otherwise
+    /// stretch one move over the whole gap and make every later sample out of order); ten samples in a row
+    /// that follow each other on another time base are followed from then on.
+    pub max_gap_s: f64,
     /// Take sample times from the header stamp (`header`) or from the arrival time (`receive`).
     pub stamp: StampSource,
     /// Also subscribe `motion/accel` (geometry_msgs/AccelStamped, vessel body frame) and use its measured
@@ -431,6 +439,7 @@ impl Default for InputCfg {
             delay_samples: 2,
             max_speed: 50.0,
             max_rotation_rate: 5.0,
+            max_gap_s: 5.0,
             stamp: StampSource::Header,
             accel: false,
         }
@@ -558,7 +567,7 @@ pub fn from_str(
             message,
         })?;
     }
-    let config: RunConfig = serde_path_to_error::deserialize(params.clone()).map_err(|e| {
+    let mut config: RunConfig = serde_path_to_error::deserialize(params.clone()).map_err(|e| {
         let key = e.path().to_string();
         ConfigError::Key {
             source_name: src(),
@@ -570,6 +579,9 @@ pub fn from_str(
             message: e.into_inner().to_string(),
         }
     })?;
+    if config.use_sim_time && config.realtime.mode == RealtimeMode::Realtime {
+        config.realtime.mode = RealtimeMode::FollowClock;
+    }
     Ok(Loaded {
         config,
         source_name: source_name.to_string(),
@@ -1061,6 +1073,23 @@ mod tests {
         assert!(e.contains("tank.length: given twice"), "{e}");
         let e = err(&text.replace("solver.dfsph.cfl", "solver.dfsph.cfll"), &[]);
         assert!(e.contains("solver.dfsph.cfll: unknown field"), "{e}");
+    }
+
+    #[test]
+    fn use_sim_time_follows_the_clock() {
+        let mode = |o: &[&str]| {
+            let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
+            from_str(MIN, "case.yaml", None, &o)
+                .unwrap()
+                .config
+                .realtime
+                .mode
+        };
+        assert_eq!(mode(&[]), RealtimeMode::Realtime);
+        assert_eq!(mode(&["use_sim_time=true"]), RealtimeMode::FollowClock);
+        assert_eq!(mode(&["use_sim_time=false"]), RealtimeMode::Realtime);
+        let lockstep = ["use_sim_time=true", "realtime.mode=lockstep"];
+        assert_eq!(mode(&lockstep), RealtimeMode::Lockstep);
     }
 
     #[test]

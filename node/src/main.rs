@@ -197,7 +197,7 @@ enum Command {
         #[arg(long)]
         lockstep: bool,
         /// Stamp of the first sample in seconds since the epoch (default: now).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         start_stamp: Option<f64>,
         /// Publish `slosh::MotionSample`s on the iceoryx2 service NAME/motion instead of DDS (for a node
         /// with `input.type: iceoryx2`).
@@ -303,6 +303,16 @@ fn main() -> std::process::ExitCode {
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
+    // Started by mpirun without MPI support, every rank would run the whole case on its own, all writing the
+    // same outputs.
+    #[cfg(not(feature = "mpi"))]
+    if let Some(n) = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
+        .iter()
+        .find_map(|v| std::env::var(v).ok()?.parse::<u32>().ok())
+        .filter(|n| *n > 1)
+    {
+        anyhow::bail!("started as one of {n} MPI ranks, but this slosh was built without MPI: build it with `cargo build --release -p slosh-node --features mpi` (see the README's MPI section), or run it without mpirun");
+    }
     // Under mpirun every rank runs this binary: rank 0 goes on with the command (its simulations spread
     // over all ranks), the others follow its solver calls until it is done.
     #[cfg(feature = "mpi")]

@@ -300,7 +300,11 @@ impl Recorder {
         y += "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n";
         y += &format!("  duration:\n    nanoseconds: {duration}\n");
         y += &format!("  starting_time:\n    nanoseconds_since_epoch: {start}\n");
-        y += &format!("  message_count: {total}\n  topics_with_message_count:\n");
+        // An empty list is written `[]`: a bare key would read as null, which rosbags refuses.
+        y += &format!(
+            "  message_count: {total}\n  topics_with_message_count:{}\n",
+            if self.channels.is_empty() { " []" } else { "" }
+        );
         for (topic, c) in &self.channels {
             y += &format!(
                 "    - topic_metadata:\n        name: {topic}\n        type: {}\n        serialization_format: cdr\n        offered_qos_profiles: \"{OFFERED_QOS}\"\n      message_count: {}\n",

@@ -237,6 +237,29 @@ fn node_rejects_a_bad_parameter_at_startup_naming_it() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("motion_timeout_s"), "{err}");
+    for (p, key) in [
+        (
+            "diagnostics_rate_hz:=-1",
+            "diagnostics_rate_hz: must be a positive",
+        ),
+        (
+            "diagnostics_rate_hz:=0",
+            "diagnostics_rate_hz: must be a positive",
+        ),
+        (
+            "particles.rate_hz:=-5",
+            "particles.rate_hz: must be zero (off) or",
+        ),
+    ] {
+        let out = slosh()
+            .args(["node", "seed_tank_039", "--ros-args", "-p", p])
+            .env("ROS_DOMAIN_ID", "999")
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{p} accepted");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(key), "{p}: {err}");
+    }
 }
 
 #[test]
@@ -331,4 +354,29 @@ fn bench_reports_json_and_applies_overrides() {
         "{}",
         String::from_utf8_lossy(&st.stderr)
     );
+}
+
+#[test]
+fn motion_publisher_rejects_a_start_stamp_that_cannot_be_a_ros_time() {
+    for s in ["nan", "-5", "1e30"] {
+        let out = slosh()
+            .args([
+                "motion",
+                "seed_tank_039",
+                "--iceoryx2",
+                "slosh_test_start_stamp",
+                "--duration",
+                "1",
+                "--start-stamp",
+                s,
+            ])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "--start-stamp {s} accepted");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--start-stamp: must be seconds since the epoch"),
+            "{s}: {err}"
+        );
+    }
 }

@@ -248,3 +248,24 @@ fn a_full_disk_stops_the_run_with_a_clear_error_and_keeps_the_csv_outputs() {
     assert!(!dir.join("out2/wrench.csv").exists(), "nothing was run");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn an_empty_recording_is_read_by_rosbags_and_mcap() {
+    // A node stopped before any motion arrived (a wrong remap) leaves a bag with no messages.
+    let dir = common::tmp("record-empty");
+    let cfg = slosh_node::record::RecordCfg {
+        path: dir.join("bag").display().to_string(),
+        ..Default::default()
+    };
+    let mut r =
+        slosh_node::record::Recorder::create(&cfg, &serde_json::json!({"case": "empty"})).unwrap();
+    r.finish().unwrap();
+    let v = common::read_bag(&dir.join("bag"));
+    assert_eq!(v["rosbags"], serde_json::json!({}), "{v}");
+    assert_eq!(v["mcap"], serde_json::json!({}), "{v}");
+    assert!(v["metadata"]["slosh_parameters"]["parameters"]
+        .as_str()
+        .unwrap()
+        .contains("empty"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -566,12 +566,14 @@ fn follow_clock_never_runs_ahead_of_ros_time() {
         "clock",
         &QosProfile::subscription_default().history(History::KeepLast { depth: 1 }),
     );
+    let log = dir.join("node.log");
     let _node_proc = Kill(
         slosh()
             .args(["node", "--ros-args", "--params-file"])
             .arg(&case)
             .args(["-p", "realtime.mode:=follow_clock"])
             .env("ROS_DOMAIN_ID", "37")
+            .stderr(std::fs::File::create(&log).unwrap())
             .spawn()
             .unwrap(),
     );
@@ -589,6 +591,13 @@ fn follow_clock_never_runs_ahead_of_ros_time() {
         let _ = odom.publish(rest_odometry(200.0 + k as f64 * 0.02));
         std::thread::sleep(Duration::from_millis(5));
     }
+    // Before any /clock the node waits; after 5 s it says what for.
+    std::thread::sleep(Duration::from_millis(5500));
+    let said = std::fs::read_to_string(&log).unwrap();
+    assert!(
+        said.contains("follow_clock") && said.contains("no message on /clock"),
+        "{said}"
+    );
     let mut last = f64::NEG_INFINITY;
     for _ in 0..20 {
         let _ = clock.publish(Clock {
@@ -635,17 +644,19 @@ fn ros_domain_id_takes_effect() {
     };
     let (_c1, _n1, right) = listen(41);
     let (_c2, _n2, wrong) = listen(42);
+    let log = dir.join("node.log");
     let _node_proc = Kill(
         slosh()
             .args(["node", "--ros-args", "--params-file"])
             .arg(&case)
             .env("ROS_DOMAIN_ID", "41")
+            .stderr(std::fs::File::create(&log).unwrap())
             .spawn()
             .unwrap(),
     );
     let (mut n_right, mut n_wrong) = (0, 0);
     let start = Instant::now();
-    while start.elapsed() < Duration::from_secs(4) {
+    while start.elapsed() < Duration::from_millis(6500) {
         while let Ok(Some(_)) = right.take() {
             n_right += 1;
         }
@@ -659,6 +670,12 @@ fn ros_domain_id_takes_effect() {
         "{n_right} diagnostics on the node's domain 41"
     );
     assert_eq!(n_wrong, 0, "diagnostics leaked to domain 42");
+    // Nobody publishes motion here: after 5 s the node says so, and where it listens.
+    let said = std::fs::read_to_string(&log).unwrap();
+    assert!(
+        said.contains("no motion sample yet after 5 s on /motion/odom: is the publisher running"),
+        "{said}"
+    );
     let out = slosh()
         .args(["node", "seed_tank_039"])
         .env("ROS_DOMAIN_ID", "ship")

@@ -5,7 +5,8 @@
 //! simulation (its time is the simulation's zero). Every answer is also published on `NAME/outputs`, and
 //! particle frames on `NAME/particles` at `--particles HZ` of sample time.
 //!
-//! A refused sample (NaN, not later than the last, not a unit quaternion) is answered with
+//! A refused sample (NaN, not later than the last, not a unit quaternion, a move or turn from the last
+//! sample faster than `input.max_speed` / `input.max_rotation_rate`) is answered with
 //! [`STATUS_REJECTED`] and the field named; nothing is simulated. A solver failure is answered with
 //! [`STATUS_FAILED`] and stops the server with the error. A client that dies mid-step disturbs nothing:
 //! its answer is dropped and its resources are cleaned up.
@@ -76,6 +77,10 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
         offset: Vector3::new(tp.x, tp.y, tp.z),
         rotation: UnitQuaternion::from_euler_angles(tp.roll, tp.pitch, tp.yaw),
     };
+    let limits = crate::ros::live_motion::Limits {
+        max_speed: cfg.config.input.max_speed,
+        max_rotation_rate: cfg.config.input.max_rotation_rate,
+    };
     let mut sim = sph::build(params.clone())?;
     let mut csv = match &opts.out {
         Some(d) => Some(CsvOutputs::create(d, &params)?),
@@ -131,6 +136,7 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
                 &mut initial,
                 &s,
                 &mount,
+                &limits,
                 opts.dry,
             );
             if answer.status == STATUS_REJECTED {
@@ -188,6 +194,7 @@ fn step(
     initial: &mut Option<StepOutputs>,
     s: &MotionSample,
     mount: &Mount,
+    limits: &crate::ros::live_motion::Limits,
     dry: bool,
 ) -> (StepOutputs, Option<anyhow::Error>) {
     let reject = |msg: String| {
@@ -216,6 +223,22 @@ fn step(
                     "time: {} s is not after the last sample's {} s",
                     s.time,
                     m.newest() + *t0
+                ));
+            }
+            // A jump the tank cannot have made (a garbled sample) would only collapse the solver's step.
+            let (dt, last) = (t - m.newest(), m.state(m.newest()));
+            let moved = (state.position - last.position).norm();
+            if moved > limits.max_speed * dt {
+                return reject(format!(
+                    "position: moves {moved:.3} m in {dt:.4} s from the last sample, faster than input.max_speed = {} m/s",
+                    limits.max_speed
+                ));
+            }
+            let turned = last.orientation.angle_to(&state.orientation);
+            if turned > limits.max_rotation_rate * dt {
+                return reject(format!(
+                    "orientation: turns {turned:.3} rad in {dt:.4} s from the last sample, faster than input.max_rotation_rate = {} rad/s",
+                    limits.max_rotation_rate
                 ));
             }
             m.push(t, state);

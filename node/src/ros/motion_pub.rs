@@ -132,6 +132,16 @@ pub fn checked_motion(
             opts.duration
         );
     }
+    if let Some(s) = opts.start_stamp {
+        // builtin_interfaces/Time holds whole seconds in an i32: the last sample must fit too.
+        let last = s + opts.duration;
+        if !(s.is_finite() && s >= 0.0 && last < i32::MAX as f64) {
+            anyhow::bail!(
+                "--start-stamp: must be seconds since the epoch from 0 to {} (less --duration), got {s}",
+                i32::MAX
+            );
+        }
+    }
     let cfg = crate::config::load(config, params)?;
     let motion = motion_source::build(&cfg)?;
     if opts.duration > motion.end_time() {

@@ -27,10 +27,14 @@ use slosh_msgs::std_msgs::Header;
 use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
 use slosh_msgs::tf2_msgs::TFMessage;
 use sph::params::SimParams;
+use std::collections::VecDeque;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 /// The node's default name (`-r __node:=...` changes it).
+/// Samples in a row on a new time base after which the node follows it (see the input loop).
+const NEW_TIME_BASE: usize = 10;
+
 pub const DEFAULT_NAME: &str = "slosh";
 
 /// Options of `slosh node` besides the parameters.
@@ -346,6 +350,27 @@ pub fn run(
             c.motion_timeout_s
         );
     }
+    if !(c.input.max_gap_s.is_finite() && c.input.max_gap_s > 0.0) {
+        anyhow::bail!(
+            "{}: input.max_gap_s: must be a positive number of seconds, got {}",
+            cfg.source_name,
+            c.input.max_gap_s
+        );
+    }
+    if !(c.diagnostics_rate_hz.is_finite() && c.diagnostics_rate_hz > 0.0) {
+        anyhow::bail!(
+            "{}: diagnostics_rate_hz: must be a positive number of messages per second, got {}",
+            cfg.source_name,
+            c.diagnostics_rate_hz
+        );
+    }
+    if !(c.particles.rate_hz.is_finite() && c.particles.rate_hz >= 0.0) {
+        anyhow::bail!(
+            "{}: particles.rate_hz: must be zero (off) or a positive number of clouds per simulated second, got {}",
+            cfg.source_name,
+            c.particles.rate_hz
+        );
+    }
     let stop = super::shutdown_flag()?;
     let context = super::context()?;
     let mut node = context
@@ -588,6 +613,15 @@ pub fn run(
     let mut next_output = 0u64;
     let mut last_diag = f64::NEG_INFINITY;
     let mut last_warn = f64::NEG_INFINITY;
+    // The stamp (s) of the newest accepted motion sample, and the samples rejected in a row since that look
+    // like a motion on another time base.
+    let mut newest_stamp: Option<f64> = None;
+    let mut other_base: Vec<(f64, Reading)> = Vec::new();
+    // follow_clock without /clock: since when, and when the node last said so.
+    let mut no_clock_since: Option<f64> = None;
+    let mut last_no_clock = 0.0;
+    // When the node last said it is still waiting for its first motion sample.
+    let mut last_waiting = 0.0;
     let mut holding = false;
     let mut tf_sent = false;
     let dt_cap = params.solver.dt_max;
@@ -611,6 +645,7 @@ pub fn run(
         while let Ok(Some((id, _))) = srv_reset.receive_request() {
             sim = sph::build(params.clone())?;
             motion = fresh_motion();
+            newest_stamp = None;
             next_output = 0;
             next_cloud = 0;
             rebase = t0.is_some();
@@ -637,6 +672,7 @@ pub fn run(
                 paused = false;
                 // Resume from the current input without catching up on the paused stretch.
                 motion = fresh_motion();
+                newest_stamp = None;
                 rebase = t0.is_some();
                 format!("resumed at t = {:.4} s", sim.time())
             };
@@ -657,22 +693,43 @@ pub fn run(
         while let Some(sample) = input.take(recorder.as_mut().map(|r| (r, in_topic.as_str())))? {
             pending.push(sample);
         }
-        for (stamp, reading) in pending.drain(..) {
+        let stamp_s = |stamp: Time| match c.input.stamp {
+            StampSource::Header => stamp.as_secs_f64(),
+            StampSource::Receive => std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_secs_f64())
+                .unwrap_or(0.0),
+        };
+        let mut incoming: VecDeque<(f64, Reading)> = pending
+            .drain(..)
+            .map(|(stamp, reading)| (stamp_s(stamp), reading))
+            .collect();
+        while let Some((ts, reading)) = incoming.pop_front() {
             let w = wall();
-            let ts = match c.input.stamp {
-                StampSource::Header => stamp.as_secs_f64(),
-                StampSource::Receive => std::time::SystemTime::now()
-                    .duration_since(std::time::UNIX_EPOCH)
-                    .map(|d| d.as_secs_f64())
-                    .unwrap_or(0.0),
-            };
             if rebase {
                 rebase = false;
                 t0 = Some(ts - sim.time());
             }
             let base = *t0.get_or_insert(ts);
-            match motion.push(ts - base, &reading, &frames) {
+            // A stamp far ahead of the newest sample (a garbled stamp, a clock set wrong) is rejected: the
+            // solver would take the whole gap as one smooth move, and every later sample as out of order.
+            let gap = newest_stamp
+                .map(|n| ts - n)
+                .filter(|g| *g > c.input.max_gap_s);
+            let pushed = match gap {
+                Some(g) => Err(format!(
+                    "stamp {:.6} s is {g:.3} s after the newest sample's, more than input.max_gap_s = {}",
+                    ts - base,
+                    c.input.max_gap_s
+                )),
+                None => motion
+                    .push(ts - base, &reading, &frames)
+                    .map_err(|e| e.to_string()),
+            };
+            match pushed {
                 Ok(()) => {
+                    newest_stamp = Some(ts);
+                    other_base.clear();
                     last_real = ts - base;
                     counters.accepted += 1;
                     pacing.input(w);
@@ -684,7 +741,7 @@ pub fn run(
                 }
                 Err(e) => {
                     counters.rejected += 1;
-                    counters.last_reject = e.to_string();
+                    counters.last_reject = e.clone();
                     if w - last_warn > 1.0 {
                         last_warn = w;
                         log(
@@ -694,6 +751,37 @@ pub fn run(
                                 counters.rejected
                             ),
                         );
+                    }
+                    // Samples on another time base (a publisher restarted with other stamps, a clock
+                    // reset): once NEW_TIME_BASE of them in a row follow each other as a motion would, the
+                    // input follows them from the simulation's present, as after a pause.
+                    let off = gap.is_some() || newest_stamp.is_some_and(|n| ts <= n);
+                    let follows = other_base
+                        .last()
+                        .is_none_or(|(p, _)| ts > *p && ts - p <= c.input.max_gap_s);
+                    if !off {
+                        other_base.clear();
+                    } else {
+                        if !follows {
+                            other_base.clear();
+                        }
+                        other_base.push((ts, reading));
+                        if other_base.len() >= NEW_TIME_BASE {
+                            let jump = other_base[0].0 - newest_stamp.unwrap_or(other_base[0].0);
+                            log(
+                                ros2_client::ros2::LogLevel::Warn,
+                                &format!(
+                                    "the motion input's stamps jumped by {jump:.3} s and {NEW_TIME_BASE} samples in a row follow the new stamps: following them from t = {:.4} s (a restarted publisher or a reset clock)",
+                                    sim.time()
+                                ),
+                            );
+                            motion = fresh_motion();
+                            rebase = true;
+                            newest_stamp = None;
+                            for item in other_base.drain(..).rev() {
+                                incoming.push_front(item);
+                            }
+                        }
                     }
                 }
             }
@@ -709,6 +797,28 @@ pub fn run(
         }
         let Some(base) = t0 else {
             std::thread::sleep(Duration::from_millis(2));
+            // Silence would look like a hang: say every 10 s (the first time after motion_timeout_s or
+            // 5 s, whichever is longer) that nothing has come, and where the node listens.
+            let w = wall();
+            let wait = if last_waiting == 0.0 {
+                c.motion_timeout_s.max(5.0)
+            } else {
+                10.0
+            };
+            if w - last_waiting >= wait {
+                last_waiting = w;
+                log(
+                    ros2_client::ros2::LogLevel::Warn,
+                    &format!(
+                        "no motion sample yet after {w:.0} s on {}",
+                        if c.input.kind == InputType::Iceoryx2 {
+                            format!("iceoryx2 service {}/motion: is its publisher (e.g. `slosh motion CASE --iceoryx2 {}`) running?", iox.service, iox.service)
+                        } else {
+                            format!("{in_topic}: is the publisher running, on this ROS_DOMAIN_ID, and is the topic remapped right (-r {}:=NAME)?", Input::topic(c.input.kind))
+                        }
+                    ),
+                );
+            }
             maybe_diagnostics(
                 &pub_diag,
                 recorder.as_mut().map(|r| (r, diag_topic.as_str())),
@@ -761,6 +871,28 @@ pub fn run(
         if let Some(sc) = &sub_clock {
             while let Ok(Some((m, _))) = sc.take() {
                 ros_time = Some(m.clock.as_secs_f64());
+            }
+            // Motion but no /clock: the node waits for a ROS time that never comes. Say so (once after
+            // motion_timeout_s or 5 s, then every 10 s).
+            if ros_time.is_none() && counters.accepted > 0 {
+                let w = wall();
+                let first = no_clock_since.get_or_insert(w);
+                let wait = if last_no_clock == 0.0 {
+                    c.motion_timeout_s.max(5.0)
+                } else {
+                    10.0
+                };
+                if w - *first >= wait && w - last_no_clock >= wait {
+                    last_no_clock = w;
+                    log(
+                        ros2_client::ros2::LogLevel::Warn,
+                        &format!(
+                            "realtime.mode follow_clock: {} motion samples in but no message on /clock after {:.0} s: the simulation waits for the ROS time (start the clock's publisher, e.g. `ros2 bag play --clock`, or use realtime.mode realtime)",
+                            counters.accepted,
+                            w - *first
+                        ),
+                    );
+                }
             }
         }
         let until = if paused {
@@ -882,6 +1014,8 @@ pub fn run(
             "no motion input: holding the last pose"
         } else if pacing.behind() {
             "behind real time"
+        } else if sub_clock.is_some() && ros_time.is_none() {
+            "waiting for /clock (follow_clock)"
         } else {
             "running"
         };
@@ -989,7 +1123,11 @@ fn diagnostics(
     let (counts, stats) = (sim.counts(), sim.stats());
     let level = if state == "running" {
         DiagnosticStatus::OK
-    } else if stamp.is_none() || state.starts_with("behind") || state.starts_with("paused") {
+    } else if stamp.is_none()
+        || state.starts_with("behind")
+        || state.starts_with("paused")
+        || state.starts_with("waiting")
+    {
         DiagnosticStatus::WARN
     } else {
         // No motion input (holding the last pose), or the solver stopped.
