@@ -697,7 +697,10 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
     let case = dir.join("case.yaml");
     std::fs::write(
         &case,
-        common::small_case("    motion_timeout_s: 0.5\n    diagnostics_rate_hz: 10.0\n"),
+        // The 2.1 s gap is beyond input.max_gap_s: after a timeout it is the input coming back all the same.
+        common::small_case(
+            "    motion_timeout_s: 0.5\n    diagnostics_rate_hz: 10.0\n    input: {max_gap_s: 1.0}\n",
+        ),
     )
     .unwrap();
     let (_ctx, mut node) = test_node(43, "e2e_timeout");

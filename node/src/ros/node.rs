@@ -713,9 +713,10 @@ pub fn run(
             let base = *t0.get_or_insert(ts);
             // A stamp far ahead of the newest sample (a garbled stamp, a clock set wrong) is rejected: the
             // solver would take the whole gap as one smooth move, and every later sample as out of order.
+            // Not after a timeout (holding the last pose): then a later stamp is the input coming back.
             let gap = newest_stamp
                 .map(|n| ts - n)
-                .filter(|g| *g > c.input.max_gap_s);
+                .filter(|g| *g > c.input.max_gap_s && !holding);
             let pushed = match gap {
                 Some(g) => Err(format!(
                     "stamp {:.6} s is {g:.3} s after the newest sample's, more than input.max_gap_s = {}",
