@@ -114,7 +114,8 @@ enum Command {
         /// Also write probes.csv, wrench.csv and pressure.csv here.
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Stop after this many answered steps (default: until SIGINT/SIGTERM).
+        /// Stop after this many steps past the first sample (which starts the simulation): N + 1 answers, as
+        /// many as a client's `--steps N` sends (default: until SIGINT/SIGTERM).
         #[arg(long)]
         max_steps: Option<u64>,
         /// Override a parameter by its dotted name, value as YAML.

@@ -162,7 +162,7 @@ fn coupling_follows_an_offline_run_of_the_same_motion_and_refuses_bad_samples() 
     let offline = csv(&dir.join("offline/probes.csv"));
     let offline_w = csv(&dir.join("offline/wrench.csv"));
 
-    let srv = server(&case, &["--max-steps", "21"]);
+    let srv = server(&case, &["--max-steps", "20"]);
     let client = CouplingClient::connect("t", Duration::from_secs(30)).unwrap();
     let cfg = slosh_node::config::load(case.to_str().unwrap(), &[]).unwrap();
     let motion = slosh_node::motion_source::build(&cfg).unwrap();
@@ -613,7 +613,7 @@ fn the_python_example_couples_step_for_step_like_the_rust_one() {
     std::fs::write(&case, CASE).unwrap();
     // Each example against a fresh server: the same barge, so the same samples and the same liquid.
     let run = |cmd: &mut Command| -> Vec<serde_json::Value> {
-        let srv = server(&case, &["--max-steps", "21"]);
+        let srv = server(&case, &["--max-steps", "20"]);
         let o = cmd
             .args(["--service", "t", "--steps", "20"])
             .output()

@@ -29,7 +29,8 @@ pub struct CoupleOptions {
     pub dry: bool,
     /// Also write the CSV outputs here (one row per answered step, time from the first sample).
     pub out: Option<PathBuf>,
-    /// Stop after this many answered steps (None: until SIGINT/SIGTERM).
+    /// Stop after this many steps past the first sample, which only starts the simulation: N + 1 answers,
+    /// what a client's `--steps N` sends (None: until SIGINT/SIGTERM).
     pub max_steps: Option<u64>,
 }
 
@@ -108,7 +109,7 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
     let mut last_cleanup = Instant::now();
     let result: anyhow::Result<()> = 'serve: loop {
         if stop.load(std::sync::atomic::Ordering::Relaxed)
-            || opts.max_steps.is_some_and(|m| served.steps_answered >= m)
+            || opts.max_steps.is_some_and(|m| served.steps_answered > m)
         {
             break Ok(());
         }
