@@ -371,19 +371,21 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
         message,
     };
     let files = repair_inputs(input).map_err(|m| bad(input, m))?;
-    let mut contents = Vec::with_capacity(files.len());
+    // Every file is checked before the new bag is made: nothing is written for a file that is not MCAP.
     for file in &files {
-        let bytes = std::fs::read(file).map_err(|e| bad(file, format!("cannot read: {e}")))?;
-        if !bytes.starts_with(mcap::MAGIC) {
+        let mut head = Vec::with_capacity(mcap::MAGIC.len());
+        std::fs::File::open(file)
+            .and_then(|f| {
+                use std::io::Read;
+                f.take(mcap::MAGIC.len() as u64).read_to_end(&mut head)
+            })
+            .map_err(|e| bad(file, format!("cannot read: {e}")))?;
+        if head != mcap::MAGIC {
             return Err(bad(
                 file,
-                format!(
-                    "not an MCAP file (it does not start with the MCAP magic bytes; {} bytes long)",
-                    bytes.len()
-                ),
+                "not an MCAP file (it does not start with the MCAP magic bytes)".into(),
             ));
         }
-        contents.push(bytes);
     }
     let cfg = RecordCfg {
         path: out.display().to_string(),
@@ -396,9 +398,15 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
     )?;
     let mut n = 0;
     let mut stops = Vec::new();
-    for (file, bytes) in files.iter().zip(&contents) {
+    for file in &files {
+        // One file mapped at a time (split bags may be large).
+        let f = std::fs::File::open(file).map_err(|e| bad(file, format!("cannot open: {e}")))?;
+        // SAFETY: the map is only read, while this loop runs; a file changed underneath by another process
+        // reads as damaged to the MCAP reader's checks, not as valid messages.
+        let bytes =
+            unsafe { memmap2::Mmap::map(&f) }.map_err(|e| bad(file, format!("cannot map: {e}")))?;
         let stream = mcap::MessageStream::new_with_options(
-            bytes,
+            &bytes,
             mcap::read::Options::IgnoreEndMagic.into(),
         )
         .map_err(|e| bad(file, format!("not an MCAP file: {e}")))?;

@@ -31,11 +31,34 @@ use std::collections::VecDeque;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-/// The node's default name (`-r __node:=...` changes it).
 /// Samples in a row on a new time base after which the node follows it (see the input loop).
 const NEW_TIME_BASE: usize = 10;
 
+/// The node's default name (`-r __node:=...` changes it).
 pub const DEFAULT_NAME: &str = "slosh";
+
+/// A warning repeated while a condition lasts (silence would look like a hang): first `first` s after the
+/// condition was first seen, then every 10 s.
+#[derive(Debug, Default)]
+struct Reminder {
+    since: Option<f64>,
+    last: Option<f64>,
+}
+
+impl Reminder {
+    /// Whether to warn now (wall time `now`, s), the condition holding.
+    fn due(&mut self, now: f64, first: f64) -> bool {
+        let since = *self.since.get_or_insert(now);
+        let due = match self.last {
+            None => now - since >= first,
+            Some(last) => now - last >= 10.0,
+        };
+        if due {
+            self.last = Some(now);
+        }
+        due
+    }
+}
 
 /// Options of `slosh node` besides the parameters.
 #[derive(Debug, Clone, Default)]
@@ -617,11 +640,10 @@ pub fn run(
     // like a motion on another time base.
     let mut newest_stamp: Option<f64> = None;
     let mut other_base: Vec<(f64, Reading)> = Vec::new();
-    // follow_clock without /clock: since when, and when the node last said so.
-    let mut no_clock_since: Option<f64> = None;
-    let mut last_no_clock = 0.0;
-    // When the node last said it is still waiting for its first motion sample.
-    let mut last_waiting = 0.0;
+    // Warnings while no motion sample has come yet, and while follow_clock has motion but no /clock (first
+    // after motion_timeout_s or 5 s).
+    let (mut no_motion, mut no_clock) = (Reminder::default(), Reminder::default());
+    let first_reminder = c.motion_timeout_s.max(5.0);
     let mut holding = false;
     let mut tf_sent = false;
     let dt_cap = params.solver.dt_max;
@@ -798,16 +820,8 @@ pub fn run(
         }
         let Some(base) = t0 else {
             std::thread::sleep(Duration::from_millis(2));
-            // Silence would look like a hang: say every 10 s (the first time after motion_timeout_s or
-            // 5 s, whichever is longer) that nothing has come, and where the node listens.
             let w = wall();
-            let wait = if last_waiting == 0.0 {
-                c.motion_timeout_s.max(5.0)
-            } else {
-                10.0
-            };
-            if w - last_waiting >= wait {
-                last_waiting = w;
+            if no_motion.due(w, first_reminder) {
                 log(
                     ros2_client::ros2::LogLevel::Warn,
                     &format!(
@@ -873,27 +887,15 @@ pub fn run(
             while let Ok(Some((m, _))) = sc.take() {
                 ros_time = Some(m.clock.as_secs_f64());
             }
-            // Motion but no /clock: the node waits for a ROS time that never comes. Say so (once after
-            // motion_timeout_s or 5 s, then every 10 s).
-            if ros_time.is_none() && counters.accepted > 0 {
-                let w = wall();
-                let first = no_clock_since.get_or_insert(w);
-                let wait = if last_no_clock == 0.0 {
-                    c.motion_timeout_s.max(5.0)
-                } else {
-                    10.0
-                };
-                if w - *first >= wait && w - last_no_clock >= wait {
-                    last_no_clock = w;
-                    log(
-                        ros2_client::ros2::LogLevel::Warn,
-                        &format!(
-                            "realtime.mode follow_clock: {} motion samples in but no message on /clock after {:.0} s: the simulation waits for the ROS time (start the clock's publisher, e.g. `ros2 bag play --clock`, or use realtime.mode realtime)",
-                            counters.accepted,
-                            w - *first
-                        ),
-                    );
-                }
+            // Motion but no /clock: the node waits for a ROS time that never comes.
+            if ros_time.is_none() && counters.accepted > 0 && no_clock.due(wall(), first_reminder) {
+                log(
+                    ros2_client::ros2::LogLevel::Warn,
+                    &format!(
+                        "realtime.mode follow_clock: {} motion samples in but no message on /clock yet: the simulation waits for the ROS time (start the clock's publisher, e.g. `ros2 bag play --clock`, or use realtime.mode realtime)",
+                        counters.accepted
+                    ),
+                );
             }
         }
         let until = if paused {
@@ -1179,5 +1181,22 @@ fn diagnostics(
                 kv("outputs_published", c.published.to_string()),
             ],
         }],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Reminder;
+
+    #[test]
+    fn a_reminder_comes_first_after_its_delay_then_every_ten_seconds() {
+        let mut r = Reminder::default();
+        let times: Vec<f64> = (0..300).map(|k| 1.0 + k as f64 * 0.1).collect();
+        let said: Vec<f64> = times.into_iter().filter(|&t| r.due(t, 5.0)).collect();
+        assert_eq!(said.len(), 3, "{said:?}");
+        assert!(
+            (said[0] - 6.0).abs() < 1e-9 && (said[1] - 16.0).abs() < 1e-9,
+            "{said:?}"
+        );
     }
 }
