@@ -307,11 +307,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     // Started by mpirun without MPI support, every rank would run the whole case on its own, all writing the
     // same outputs.
     #[cfg(not(feature = "mpi"))]
-    if let Some(n) = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
-        .iter()
-        .find_map(|v| std::env::var(v).ok()?.parse::<u32>().ok())
-        .filter(|n| *n > 1)
-    {
+    if let Some(n) = slosh_node::memory::mpi_world_size().filter(|n| *n > 1) {
         anyhow::bail!("started as one of {n} MPI ranks, but this slosh was built without MPI: build it with `cargo build --release -p slosh-node --features mpi` (see the README's MPI section), or run it without mpirun");
     }
     // Under mpirun every rank runs this binary: rank 0 goes on with the command (its simulations spread

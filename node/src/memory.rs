@@ -66,19 +66,26 @@ fn available_bytes() -> Option<f64> {
     Some(kib * 1024.0)
 }
 
+/// The first of the environment variables `names` that holds a count of at least 1.
+fn count_in(names: &[&str]) -> Option<u32> {
+    names
+        .iter()
+        .find_map(|n| std::env::var(n).ok()?.parse::<u32>().ok())
+        .filter(|v| *v >= 1)
+}
+
+/// How many ranks `mpirun` started, read from its environment (Open MPI's or MPICH's); None outside it.
+pub fn mpi_world_size() -> Option<u32> {
+    count_in(&["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"])
+}
+
 /// The fraction of all ranks that run on this machine (1 outside MPI).
 fn rank_share() -> f64 {
-    let var = |names: &[&str]| {
-        names
-            .iter()
-            .find_map(|n| std::env::var(n).ok()?.parse::<f64>().ok())
-            .filter(|v| *v >= 1.0)
-    };
     match (
-        var(&["OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"]),
-        var(&["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]),
+        count_in(&["OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"]),
+        mpi_world_size(),
     ) {
-        (Some(local), Some(world)) if local <= world => local / world,
+        (Some(local), Some(world)) if local <= world => local as f64 / world as f64,
         _ => 1.0,
     }
 }
