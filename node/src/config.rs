@@ -549,11 +549,7 @@ pub fn from_str(
     let src = || source_name.to_string();
     let doc: Value = serde_saphyr::from_str(text).map_err(|e| ConfigError::Yaml {
         source_name: src(),
-        // The parser's hint is for programs using it, not for whoever wrote the file.
-        message: e.to_string().replace(
-            ", set DuplicateKeyPolicy in Options if acceptable",
-            " (each parameter may be given once: remove one)",
-        ),
+        message: for_the_user(&e),
     })?;
     let mut params = ros_parameters(doc).map_err(|message| ConfigError::Layout {
         source_name: src(),
@@ -628,6 +624,20 @@ fn from_current_dir(o: &str) -> String {
         }
     }
     o.to_string()
+}
+
+/// The YAML parser's message with its hints for programs using it (which parser options would accept the
+/// text) turned into what the author of the parameters can do.
+fn for_the_user(e: &dyn std::fmt::Display) -> String {
+    e.to_string()
+        .replace(
+            ", set DuplicateKeyPolicy in Options if acceptable",
+            " (each parameter may be given once: remove one)",
+        )
+        .replace(
+            "rejected by the configured policy",
+            "(parameters must be finite numbers)",
+        )
 }
 
 /// The parameter tree with dotted names (`tank.length: 0.8`, as ROS 2 parameter files may write them) nested
@@ -708,7 +718,7 @@ pub fn apply_override(params: &mut Value, o: &str) -> Result<(), (String, String
         serde_saphyr::from_str(raw).map_err(|e| {
             (
                 key.to_string(),
-                format!("value `{raw}` is not valid YAML: {e}"),
+                format!("value `{raw}` is not valid YAML: {}", for_the_user(&e)),
             )
         })?
     };
@@ -1031,6 +1041,13 @@ mod tests {
         );
         assert!(
             err("slosh:\n  ros__parameters:\n    dimension: [\n", &[]).contains("not valid YAML")
+        );
+        let e = err(MIN, &["solver.cfl=.nan"]);
+        assert!(
+            e.contains("solver.cfl: value `.nan` is not valid YAML")
+                && e.contains("(parameters must be finite numbers)")
+                && !e.contains("policy"),
+            "{e}"
         );
         let e = err(&format!("{MIN}    dimension: 3\n"), &[]);
         assert!(
