@@ -226,21 +226,12 @@ fn step(
                     m.newest() + *t0
                 ));
             }
-            // A jump the tank cannot have made (a garbled sample) would only collapse the solver's step.
-            let (dt, last) = (t - m.newest(), m.state(m.newest()));
-            let moved = (state.position - last.position).norm();
-            if moved > limits.max_speed * dt {
-                return reject(format!(
-                    "position: moves {moved:.3} m in {dt:.4} s from the last sample, faster than input.max_speed = {} m/s",
-                    limits.max_speed
-                ));
-            }
-            let turned = last.orientation.angle_to(&state.orientation);
-            if turned > limits.max_rotation_rate * dt {
-                return reject(format!(
-                    "orientation: turns {turned:.3} rad in {dt:.4} s from the last sample, faster than input.max_rotation_rate = {} rad/s",
-                    limits.max_rotation_rate
-                ));
+            // The node's check of its iceoryx2 input.
+            let last = m.state(m.newest());
+            if let Err(e) =
+                crate::ros::live_state::check_jump(limits, t - m.newest(), &last, &state)
+            {
+                return reject(e.to_string());
             }
             m.push(t, state);
             t

@@ -12,6 +12,35 @@ use std::collections::VecDeque;
 /// Samples kept before the solver's time.
 const KEEP_BEFORE: usize = 2;
 
+/// Whether the tank can have moved from state `from` to `to` in `dt` s: no faster a move or turn than
+/// `limits` allow (a garbled sample would otherwise collapse the solver's step).
+pub fn check_jump(
+    limits: &Limits,
+    dt: f64,
+    from: &RigidState,
+    to: &RigidState,
+) -> Result<(), Rejected> {
+    let moved = (to.position - from.position).norm();
+    if moved > limits.max_speed * dt {
+        return Err(Rejected::Jump {
+            what: "position",
+            size: moved,
+            dt,
+            limit: limits.max_speed,
+        });
+    }
+    let turned = from.orientation.angle_to(&to.orientation);
+    if turned > limits.max_rotation_rate * dt {
+        return Err(Rejected::Jump {
+            what: "orientation",
+            size: turned,
+            dt,
+            limit: limits.max_rotation_rate,
+        });
+    }
+    Ok(())
+}
+
 #[derive(Debug)]
 pub struct LiveState {
     limits: Limits,
@@ -39,25 +68,7 @@ impl LiveState {
                     newest: t0,
                 });
             }
-            let dt = t - t0;
-            let moved = (s.position - s0.position).norm();
-            if moved > self.limits.max_speed * dt {
-                return Err(Rejected::Jump {
-                    what: "position",
-                    size: moved,
-                    dt,
-                    limit: self.limits.max_speed,
-                });
-            }
-            let turned = s0.orientation.angle_to(&s.orientation);
-            if turned > self.limits.max_rotation_rate * dt {
-                return Err(Rejected::Jump {
-                    what: "orientation",
-                    size: turned,
-                    dt,
-                    limit: self.limits.max_rotation_rate,
-                });
-            }
+            check_jump(&self.limits, t - t0, &s0, &s)?;
         }
         self.samples.push_back((t, s));
         Ok(())
