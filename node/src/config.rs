@@ -505,38 +505,122 @@ pub struct Loaded {
     pub base_dir: Option<PathBuf>,
     /// The parameters after overrides, as JSON (recorded in summary.json).
     pub parameters: Value,
+    /// The node sections that were applied, in order: `NAME (FILE)`.
+    pub sections: Vec<String>,
 }
 
-/// Reads a config file, or a built-in case by name, and applies `--set` overrides.
+/// Reads a config file, or a built-in case by name, and applies `--set` overrides. A file with several node
+/// sections is read as the node `slosh` would read it (see [`load_node`]); a single section is read whatever
+/// node it names.
 pub fn load(path_or_name: &str, overrides: &[String]) -> Result<Loaded, ConfigError> {
+    let (text, source_name, base_dir) = read(path_or_name)?;
+    from_str(&text, &source_name, base_dir, overrides)
+}
+
+/// Reads the parameters of the ROS 2 node whose fully qualified name is `fqn` (`/ns/name`) the way rclcpp
+/// does: from every parameters file in order, each section that applies to the node (its name, `/**`, ...;
+/// [`crate::param_file`]), a later one overriding an earlier one parameter by parameter; sections for other
+/// nodes are left alone. Then the `-p name:=value` overrides. A relative `motion.file` is relative to the
+/// folder of the file that gave it.
+pub fn load_node(files: &[String], fqn: &str, overrides: &[String]) -> Result<Loaded, ConfigError> {
+    let mut params = Map::new();
+    let mut base_dir = None;
+    let mut others = Vec::new();
+    let mut applied = Vec::new();
+    for f in files {
+        let (text, source_name, dir) = read(f)?;
+        for s in sections_of(&text, &source_name)? {
+            if !crate::param_file::applies(&s.name, fqn) {
+                others.push(format!("{} ({source_name})", s.name));
+                continue;
+            }
+            let p = group_names(s.params, &source_name)?;
+            if p.get("motion").and_then(|m| m.get("file")).is_some() {
+                base_dir = dir.clone();
+            }
+            crate::param_file::merge(&mut params, p);
+            applied.push(format!("{} ({source_name})", s.name));
+        }
+    }
+    let source_name = files.join(", ");
+    if applied.is_empty() {
+        return Err(ConfigError::Layout {
+            source_name,
+            message: format!(
+                "no parameters for this node: it is {fqn}, the file's sections are for {}. A section applies \
+                 to the node it names (`slosh:` is /slosh, in no namespace): name it `{fqn}:`, or `/**:` for \
+                 every node",
+                others.join(", ")
+            ),
+        });
+    }
+    let mut l = finish(
+        Value::Object(params),
+        &source_name,
+        base_dir,
+        overrides,
+        "-p",
+    )?;
+    l.sections = applied;
+    Ok(l)
+}
+
+/// A config file's text, its name for messages, and the folder its relative paths start from (None for a
+/// built-in case).
+fn read(path_or_name: &str) -> Result<(String, String, Option<PathBuf>), ConfigError> {
     let path = Path::new(path_or_name);
-    let (text, source_name, base_dir) = if path.exists() {
+    if path.exists() {
         let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Read {
             source_name: path_or_name.into(),
             message: e.to_string(),
         })?;
-        (
+        return Ok((
             text,
             path_or_name.to_string(),
             Some(path.parent().map(Path::to_path_buf).unwrap_or_default()),
-        )
-    } else {
-        let name = path_or_name.trim_end_matches(".yaml");
-        let name = name.rsplit('/').next().unwrap_or(name);
-        match BUILTIN.iter().find(|(n, _)| *n == name) {
-            Some((n, t)) if !path_or_name.contains('/') || !path_or_name.ends_with(".yaml") => {
-                (t.to_string(), format!("built-in case {n}"), None)
-            }
-            _ => {
-                let names: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
-                return Err(ConfigError::Read {
-                    source_name: path_or_name.into(),
-                    message: format!("no such file (built-in cases: {})", names.join(", ")),
-                });
-            }
+        ));
+    }
+    let name = path_or_name.trim_end_matches(".yaml");
+    let name = name.rsplit('/').next().unwrap_or(name);
+    match BUILTIN.iter().find(|(n, _)| *n == name) {
+        Some((n, t)) if !path_or_name.contains('/') || !path_or_name.ends_with(".yaml") => {
+            Ok((t.to_string(), format!("built-in case {n}"), None))
         }
-    };
-    from_str(&text, &source_name, base_dir, overrides)
+        _ => {
+            let names: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
+            Err(ConfigError::Read {
+                source_name: path_or_name.into(),
+                message: format!("no such file (built-in cases: {})", names.join(", ")),
+            })
+        }
+    }
+}
+
+/// The node sections of a parameters file's text.
+fn sections_of(
+    text: &str,
+    source_name: &str,
+) -> Result<Vec<crate::param_file::Section>, ConfigError> {
+    let doc: Value = serde_saphyr::from_str(text).map_err(|e| ConfigError::Yaml {
+        source_name: source_name.into(),
+        message: for_the_user(&e),
+    })?;
+    crate::param_file::sections(doc).map_err(|message| ConfigError::Layout {
+        source_name: source_name.into(),
+        message,
+    })
+}
+
+/// A section's parameters with dotted names made groups ([`nested`]).
+fn group_names(params: Value, source_name: &str) -> Result<Map<String, Value>, ConfigError> {
+    match nested(params, "") {
+        Ok(Value::Object(m)) => Ok(m),
+        Ok(_) => unreachable!("a section's parameters are a map"),
+        Err(message) => Err(ConfigError::Layout {
+            source_name: source_name.into(),
+            message,
+        }),
+    }
 }
 
 /// Parses configuration text (see [`load`]).
@@ -546,27 +630,76 @@ pub fn from_str(
     base_dir: Option<PathBuf>,
     overrides: &[String],
 ) -> Result<Loaded, ConfigError> {
-    let src = || source_name.to_string();
-    let doc: Value = serde_saphyr::from_str(text).map_err(|e| ConfigError::Yaml {
-        source_name: src(),
-        message: for_the_user(&e),
-    })?;
-    let mut params = ros_parameters(doc).map_err(|message| ConfigError::Layout {
-        source_name: src(),
-        message,
-    })?;
+    let sections = sections_of(text, source_name)?;
+    let chosen = if sections.len() == 1 {
+        sections
+    } else {
+        let fqn = format!("/{}", crate::ros::node::DEFAULT_NAME);
+        let (mine, others): (Vec<_>, Vec<_>) = sections
+            .into_iter()
+            .partition(|s| crate::param_file::applies(&s.name, &fqn));
+        if mine.is_empty() {
+            let names: Vec<&str> = others.iter().map(|s| s.name.as_str()).collect();
+            return Err(ConfigError::Layout {
+                source_name: source_name.into(),
+                message: format!(
+                    "several node sections ({}) and none for {fqn}: a file with several is read as the node \
+                     {fqn} reads it (its sections `{}:`, `/**:`, ...); `slosh node` reads those for its own name",
+                    names.join(", "),
+                    crate::ros::node::DEFAULT_NAME,
+                ),
+            });
+        }
+        mine
+    };
+    let mut params = Map::new();
+    let mut applied = Vec::new();
+    for s in chosen {
+        crate::param_file::merge(&mut params, group_names(s.params, source_name)?);
+        applied.push(format!("{} ({source_name})", s.name));
+    }
+    let mut l = finish(
+        Value::Object(params),
+        source_name,
+        base_dir,
+        overrides,
+        "--set",
+    )?;
+    l.sections = applied;
+    Ok(l)
+}
+
+/// Applies the overrides (given with `flag`) and reads the parameters into a [`RunConfig`].
+fn finish(
+    mut params: Value,
+    source_name: &str,
+    base_dir: Option<PathBuf>,
+    overrides: &[String],
+    flag: &str,
+) -> Result<Loaded, ConfigError> {
+    let mut keys = Vec::new();
     for o in overrides {
         let o = &from_current_dir(o);
         apply_override(&mut params, o).map_err(|(key, message)| ConfigError::Key {
-            source_name: src(),
+            source_name: flag.into(),
             key,
             message,
         })?;
+        keys.push(
+            o.split_once('=')
+                .map_or(o.as_str(), |(k, _)| k)
+                .trim()
+                .to_string(),
+        );
     }
     let mut config: RunConfig = serde_path_to_error::deserialize(params.clone()).map_err(|e| {
         let key = e.path().to_string();
+        // An error in a parameter an override set (or in a group it set) is the override's.
+        let given = keys.iter().any(|k| {
+            *k == key || key.starts_with(&format!("{k}.")) || k.starts_with(&format!("{key}."))
+        });
         ConfigError::Key {
-            source_name: src(),
+            source_name: if given { flag } else { source_name }.into(),
             key: if key == "." {
                 "(top level)".into()
             } else {
@@ -583,31 +716,8 @@ pub fn from_str(
         source_name: source_name.to_string(),
         base_dir,
         parameters: params,
+        sections: Vec::new(),
     })
-}
-
-/// The `ros__parameters` map of the single node in a ROS 2 parameters file.
-fn ros_parameters(doc: Value) -> Result<Value, String> {
-    let Value::Object(top) = doc else {
-        return Err(
-            "expected a map `<node name>: {ros__parameters: {...}}` (the ROS 2 parameters layout)"
-                .into(),
-        );
-    };
-    if top.len() != 1 {
-        let keys: Vec<&String> = top.keys().collect();
-        return Err(format!("expected exactly one node name at the top level (e.g. `slosh:` or `/**:`), found {keys:?}"));
-    }
-    let (node, body) = top.into_iter().next().unwrap();
-    match body {
-        Value::Object(mut m) => match m.remove("ros__parameters") {
-            Some(p @ Value::Object(_)) if m.is_empty() => nested(p, ""),
-            Some(_) if !m.is_empty() => Err(format!("{node}: only `ros__parameters` may sit under the node name, found {:?}", m.keys().collect::<Vec<_>>())),
-            Some(_) => Err(format!("{node}.ros__parameters: expected a map of parameters")),
-            None => Err(format!("{node}: missing `ros__parameters:` (the ROS 2 parameters layout is `{node}: {{ros__parameters: {{...}}}}`)")),
-        },
-        _ => Err(format!("{node}: expected `ros__parameters:` under the node name")),
-    }
 }
 
 /// A `motion.file=PATH` override with a relative PATH made absolute from the current folder (where the user
@@ -1037,7 +1147,7 @@ mod tests {
         assert!(err("slosh: {}\n", &[]).contains("missing `ros__parameters:`"));
         assert!(
             err("a: {ros__parameters: {}}\nb: {ros__parameters: {}}\n", &[])
-                .contains("exactly one node name")
+                .contains("several node sections (/a, /b) and none for /slosh")
         );
         assert!(
             err("slosh:\n  ros__parameters:\n    dimension: [\n", &[]).contains("not valid YAML")
@@ -1076,6 +1186,82 @@ mod tests {
         let l = load(&cfg, &["motion.file=/abs/m.csv".into()]).unwrap();
         assert_eq!(l.motion_file().unwrap(), PathBuf::from("/abs/m.csv"));
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_node_reads_the_sections_for_its_name_from_every_file_in_order() {
+        let dir = std::env::temp_dir().join(format!("slosh-config-node-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        let every = MIN.replace("slosh:", "/**:");
+        let a = dir.join("a.yaml");
+        std::fs::write(
+            &a,
+            format!(
+                "{every}    motion: {{source: csv, file: m.csv}}\n\
+                 other_node:\n  ros__parameters:\n    dimension: 3\n\
+                 /ship1/tank2:\n  ros__parameters:\n    fill_height: 0.2\n    solver: {{cfl: 0.1}}\n"
+            ),
+        )
+        .unwrap();
+        let b = dir.join("sub/b.yaml");
+        std::fs::write(
+            &b,
+            "ship1:\n  '*':\n    ros__parameters:\n      solver.cfl: 0.15\n      motion: {source: csv, file: n.csv}\n",
+        )
+        .unwrap();
+        let files = [a.display().to_string(), b.display().to_string()];
+        let l = load_node(&files, "/ship1/tank2", &[]).unwrap();
+        let p = l.sim_params().unwrap();
+        // The other node's 3D is not applied; this node's fill height is; the second file's cfl overrides the
+        // first's, and the first file's section's other parameters stay.
+        assert_eq!(
+            (p.dimension, l.config.fill_height, p.solver.cfl),
+            (2, 0.2, 0.15)
+        );
+        assert_eq!(l.motion_file().unwrap(), dir.join("sub/n.csv"));
+        assert_eq!(l.sections.len(), 3, "{:?}", l.sections);
+        // Another node in the same launch gets the common section only.
+        let l = load_node(&files, "/ship2/tank2", &[]).unwrap();
+        let p = l.sim_params().unwrap();
+        assert_eq!((p.dimension, l.config.fill_height), (2, 0.39));
+        assert_eq!(l.motion_file().unwrap(), dir.join("m.csv"));
+        // No section for the node: named, with the fix.
+        let only = dir.join("c.yaml");
+        std::fs::write(&only, MIN.replace("slosh:", "controller:")).unwrap();
+        let e = load_node(&[only.display().to_string()], "/slosh", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("no parameters for this node: it is /slosh, the file's sections are for /controller")
+                && e.contains("name it `/slosh:`, or `/**:`"),
+            "{e}"
+        );
+        // `slosh run` reads a single section whatever its name.
+        assert!(load(&only.display().to_string(), &[]).is_ok());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn an_override_s_errors_name_the_override_not_the_file() {
+        let files = [String::from("seed_tank_039")];
+        let e = |o: &str| {
+            load_node(&files, "/slosh", &[o.to_string()])
+                .unwrap_err()
+                .to_string()
+        };
+        let m = e("solver.cfll=0.1");
+        assert!(m.starts_with("-p: solver.cfll: unknown field"), "{m}");
+        let m = e("solver.cfl=[1");
+        assert!(
+            m.starts_with("-p: solver.cfl: value `[1` is not valid YAML"),
+            "{m}"
+        );
+        let m = e("solver=3");
+        assert!(m.starts_with("-p: solver: "), "{m}");
+        let m = load("seed_tank_039", &["dimension=two".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(m.starts_with("--set: dimension: "), "{m}");
     }
 
     #[test]

@@ -10,6 +10,7 @@ pub mod iox;
 pub mod memory;
 pub mod motion_source;
 pub mod output;
+pub mod param_file;
 pub mod plot;
 pub mod record;
 pub mod render;

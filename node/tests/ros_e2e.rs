@@ -110,7 +110,13 @@ fn compare_with_run(kind: &str, domain_id: u16) {
 fn compare_with_run_on(kind: &str, domain_id: u16, ranks: usize) {
     let dir = common::tmp(&format!("ros-e2e-{kind}-{ranks}"));
     let case = dir.join("case.yaml");
-    std::fs::write(&case, common::small_case(EXTRA)).unwrap();
+    // As in a launch with several nodes: the parameters for every node, this node's own section (lockstep
+    // pacing, which the comparison with `slosh run` needs), and another node's (3D at 0.5 m spacing: the
+    // comparison would fail if it were applied). `slosh run` and `slosh motion` read the file as the node
+    // `/slosh` would, the first section only.
+    let own = "/ship1/tank2:\n  ros__parameters:\n    realtime: {mode: lockstep}\n";
+    let other = "other_node:\n  ros__parameters:\n    dimension: 3\n    particle_spacing: 0.5\n";
+    std::fs::write(&case, format!("{}{own}{other}", common::small_case(EXTRA))).unwrap();
     let domain = domain_id.to_string();
     let domain = domain.as_str();
 
@@ -134,14 +140,7 @@ fn compare_with_run_on(kind: &str, domain_id: u16, ranks: usize) {
             "--params-file",
         ])
         .arg(&case)
-        .args([
-            "-r",
-            "__ns:=/ship1",
-            "-r",
-            "__node:=tank2",
-            "-p",
-            "realtime.mode:=lockstep",
-        ])
+        .args(["-r", "__ns:=/ship1", "-r", "__node:=tank2"])
         .args(["-p", &format!("record.path:={}", dir.join("bag").display())])
         .args(["-p", "particles.rate_hz:=5.0"])
         .args(match kind {

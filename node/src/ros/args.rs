@@ -174,6 +174,15 @@ impl Names {
         Ok(names)
     }
 
+    /// The node's fully qualified name, `/namespace/node` (`/node` in the root namespace).
+    pub fn node_fqn(&self) -> String {
+        if self.namespace == "/" {
+            format!("/{}", self.node)
+        } else {
+            format!("{}/{}", self.namespace, self.node)
+        }
+    }
+
     /// The fully qualified name without remapping: relative names go under the namespace, `~` is the node.
     fn expand(&self, name: &str) -> Result<String, ArgError> {
         let ns = if self.namespace == "/" {

@@ -67,20 +67,19 @@ pub struct NodeOptionsCli {
     pub duration: Option<f64>,
 }
 
-/// Loads the parameters the ROS way: `--params-file` files in order (the last file's node section is used
-/// as the base; ROS merges files, we take one and apply `-p` on top), then `-p name:=value`.
+/// Loads the parameters the ROS way ([`crate::config::load_node`]): every `--params-file` in order, the
+/// sections of each that apply to this node (after `-r __ns:=` / `__node:=`), then `-p name:=value`.
+/// Without a parameters file, the `fallback` file or built-in case, read the same way.
 pub fn load_parameters(ros: &RosArgs, fallback: Option<&str>) -> anyhow::Result<Loaded> {
-    let file = match (ros.params_files.last(), fallback) {
-        (Some(f), _) => f.clone(),
-        (None, Some(f)) => f.to_string(),
-        (None, None) => anyhow::bail!(
+    let files = match (ros.params_files.is_empty(), fallback) {
+        (false, _) => ros.params_files.clone(),
+        (true, Some(f)) => vec![f.to_string()],
+        (true, None) => anyhow::bail!(
             "no parameters: pass --ros-args --params-file launch-configs/<case>.yaml (or a built-in case name)"
         ),
     };
-    if ros.params_files.len() > 1 {
-        anyhow::bail!("--params-file: give one parameters file (got {}); override single parameters with -p name:=value", ros.params_files.len());
-    }
-    Ok(crate::config::load(&file, &ros.params)?)
+    let fqn = Names::new(ros, DEFAULT_NAME)?.node_fqn();
+    Ok(crate::config::load_node(&files, &fqn, &ros.params)?)
 }
 
 fn qos_outputs() -> QosProfile {
@@ -589,15 +588,7 @@ pub fn run(
         Some(Recorder::create(&c.record, &cfg.parameters)?)
     };
     let counts = sim.counts();
-    let full_name = format!(
-        "{}/{}",
-        if names.namespace == "/" {
-            ""
-        } else {
-            &names.namespace
-        },
-        names.node
-    );
+    let full_name = names.node_fqn();
     let log = |level: ros2_client::ros2::LogLevel, msg: &str| {
         eprintln!("[{full_name}] {msg}");
         ros2_client::rosout!(node, level, "{}", msg);
@@ -605,8 +596,8 @@ pub fn run(
     log(
         ros2_client::ros2::LogLevel::Info,
         &format!(
-            "{}: {}D tank {} x {} x {} m, {} liquid + {} wall particles (dp {} m, auto resolution: {}), {:?} mode; waiting for motion on {}",
-            cfg.source_name,
+            "parameters {}: {}D tank {} x {} x {} m, {} liquid + {} wall particles (dp {} m, auto resolution: {}), {:?} mode; waiting for motion on {}",
+            cfg.sections.join(", "),
             params.dimension,
             params.tank.length,
             params.tank.breadth,

@@ -73,11 +73,11 @@ pub fn tmp(name: &str) -> PathBuf {
     d
 }
 
-/// A small 2D case (the seed tank's 0.19 m fill at dp = 20 mm) for the ROS 2 tests; `extra` is appended to its
-/// parameters (indented by four spaces).
+/// A small 2D case (the seed tank's 0.19 m fill at dp = 20 mm) for the ROS 2 tests, for every node (`/**`);
+/// `extra` is appended to its parameters (indented by four spaces).
 pub fn small_case(extra: &str) -> String {
     format!(
-        "slosh:
+        "/**:
   ros__parameters:
     dimension: 2
     tank: {{length: 0.8, breadth: 0.25, height: 0.6}}
