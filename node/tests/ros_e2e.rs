@@ -790,6 +790,74 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
 }
 
 #[test]
+fn receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping() {
+    if !common::in_private_netns(
+        "receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping",
+    ) {
+        return;
+    }
+    let dir = common::tmp("ros-receive");
+    let case = dir.join("case.yaml");
+    // WCSPH at dp 5 mm runs slower than real time: the node steps in stretches of up to a second and takes
+    // the samples that arrive meanwhile between two steps.
+    let text = common::small_case("    input: {stamp: receive}\n")
+        .replace("particle_spacing: 0.02", "particle_spacing: 0.005");
+    std::fs::write(&case, text).unwrap();
+    let (_ctx, mut node) = test_node(45, "e2e_receive");
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
+    let proc = slosh()
+        .args(["node", "--ros-args", "--params-file"])
+        .arg(&case)
+        .env("ROS_DOMAIN_ID", "45")
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let seen = Instant::now();
+    while node.subscription_count("/motion/odom") == 0 {
+        assert!(
+            seen.elapsed() < Duration::from_secs(30),
+            "the node never subscribed"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    // 2 s of samples at 50 Hz, all with the same header stamp: only their arrival times order them.
+    let sent = 100;
+    for _ in 0..sent {
+        let _ = odom.publish(rest_odometry(0.0));
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(1500));
+    let pid = proc.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let out = proc.wait_with_output().unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{log}");
+    // Stamped when they were taken from the reader, not when a stretch of steps ended (then every sample
+    // that came in during the stretch had the same stamp and all but the first were out of order).
+    let counts = log
+        .lines()
+        .find_map(|l| l.split_once("stopping at t = ").map(|(_, r)| r.to_string()))
+        .unwrap_or_else(|| panic!("no closing line: {log}"));
+    let num = |what: &str| -> usize {
+        let head = counts.split(what).next().unwrap();
+        head.rsplit(|c: char| !c.is_ascii_digit())
+            .find(|w| !w.is_empty())
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let (accepted, rejected) = (num(" samples accepted"), num(" rejected"));
+    assert!(rejected == 0 && accepted >= sent - 5, "{counts}\n{log}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
     if !common::in_private_netns("realtime_mode_chooses_the_resolution_from_a_timed_trial") {
         return;

@@ -630,7 +630,7 @@ pub fn run(
     // The stamp (s) of the newest accepted motion sample, and the samples rejected in a row since that look
     // like a motion on another time base.
     let mut newest_stamp: Option<f64> = None;
-    let mut other_base: Vec<(f64, Reading)> = Vec::new();
+    let mut other_base: Vec<(f64, Reading, f64)> = Vec::new();
     // Warnings while no motion sample has come yet, and while follow_clock has motion but no /clock (first
     // after motion_timeout_s or 5 s).
     let (mut no_motion, mut no_clock) = (Reminder::default(), Reminder::default());
@@ -639,7 +639,15 @@ pub fn run(
     let mut tf_sent = false;
     let dt_cap = params.solver.dt_max;
     let mut error: Option<String> = None;
-    let mut pending: Vec<(Time, Reading)> = Vec::with_capacity(64);
+    // Samples taken from the reader (also between steps), with when they were taken: the node's wall clock
+    // (for the input's age) and the Unix time (the stamp of `input.stamp: receive`).
+    let mut pending: Vec<(Time, Reading, f64, f64)> = Vec::with_capacity(64);
+    let unix_now = || {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_secs_f64())
+            .unwrap_or(0.0)
+    };
     let mut last_real = 0.0;
     let mut paused = false;
     // After a reset or a resume the next sample is placed at the current simulation time.
@@ -703,21 +711,22 @@ pub fn run(
         }
         // 1. Drain the input (and what was fetched while stepping).
         let mut got = false;
-        while let Some(sample) = input.take(recorder.as_mut().map(|r| (r, in_topic.as_str())))? {
-            pending.push(sample);
+        while let Some((stamp, reading)) =
+            input.take(recorder.as_mut().map(|r| (r, in_topic.as_str())))?
+        {
+            pending.push((stamp, reading, wall(), unix_now()));
         }
-        let stamp_s = |stamp: Time| match c.input.stamp {
-            StampSource::Header => stamp.as_secs_f64(),
-            StampSource::Receive => std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map(|d| d.as_secs_f64())
-                .unwrap_or(0.0),
-        };
-        let mut incoming: VecDeque<(f64, Reading)> = pending
+        let mut incoming: VecDeque<(f64, Reading, f64)> = pending
             .drain(..)
-            .map(|(stamp, reading)| (stamp_s(stamp), reading))
+            .map(|(stamp, reading, w, unix)| {
+                let ts = match c.input.stamp {
+                    StampSource::Header => stamp.as_secs_f64(),
+                    StampSource::Receive => unix,
+                };
+                (ts, reading, w)
+            })
             .collect();
-        while let Some((ts, reading)) = incoming.pop_front() {
+        while let Some((ts, reading, received)) = incoming.pop_front() {
             let w = wall();
             if rebase {
                 rebase = false;
@@ -746,7 +755,7 @@ pub fn run(
                     other_base.clear();
                     last_real = ts - base;
                     counters.accepted += 1;
-                    pacing.input(w);
+                    pacing.input(received);
                     got = true;
                     if holding {
                         holding = false;
@@ -772,14 +781,14 @@ pub fn run(
                     let off = gap.is_some() || newest_stamp.is_some_and(|n| ts <= n);
                     let follows = other_base
                         .last()
-                        .is_none_or(|(p, _)| ts > *p && ts - p <= c.input.max_gap_s);
+                        .is_none_or(|(p, _, _)| ts > *p && ts - p <= c.input.max_gap_s);
                     if !off {
                         other_base.clear();
                     } else {
                         if !follows {
                             other_base.clear();
                         }
-                        other_base.push((ts, reading));
+                        other_base.push((ts, reading, received));
                         if other_base.len() >= NEW_TIME_BASE {
                             let jump = other_base[0].0 - newest_stamp.unwrap_or(other_base[0].0);
                             log(
@@ -918,10 +927,10 @@ pub fn run(
                 stepped = true;
                 // Fetch input between steps so that the reader's short history (keep last 5) never
                 // overflows while a long stretch is stepped.
-                while let Some(sample) =
+                while let Some((stamp, reading)) =
                     input.take(recorder.as_mut().map(|r| (r, in_topic.as_str())))?
                 {
-                    pending.push(sample);
+                    pending.push((stamp, reading, wall(), unix_now()));
                 }
                 let t = sim.time();
                 if t >= next_output as f64 / rate - 1e-9 {
