@@ -507,6 +507,9 @@ pub struct Loaded {
     pub parameters: Value,
     /// The node sections that were applied, in order: `NAME (FILE)`.
     pub sections: Vec<String>,
+    /// The parameters overrides set, and the flag they were given with (`--set`, `-p`).
+    pub overridden: Vec<String>,
+    pub flag: &'static str,
 }
 
 /// Reads a config file, or a built-in case by name, and applies `--set` overrides. A file with several node
@@ -675,7 +678,7 @@ fn finish(
     source_name: &str,
     base_dir: Option<PathBuf>,
     overrides: &[String],
-    flag: &str,
+    flag: &'static str,
 ) -> Result<Loaded, ConfigError> {
     let mut keys = Vec::new();
     for o in overrides {
@@ -717,6 +720,8 @@ fn finish(
         base_dir,
         parameters: params,
         sections: Vec::new(),
+        overridden: keys,
+        flag,
     })
 }
 
@@ -900,8 +905,52 @@ fn six(src: &str, key: &str, v: &[f64]) -> Result<[f64; 6], ConfigError> {
 }
 
 impl Loaded {
-    /// The solver's parameters.
+    /// Where the value of parameter `key` came from, for messages: the override flag (`--set` / `-p`) when
+    /// an override set it (or the group it is in, or a parameter inside it), else the file.
+    pub fn source_of(&self, key: &str) -> &str {
+        let covers = |k: &String| {
+            k == key || key.starts_with(&format!("{k}.")) || k.starts_with(&format!("{key}."))
+        };
+        if self.overridden.iter().any(covers) {
+            self.flag
+        } else {
+            &self.source_name
+        }
+    }
+
+    /// `e` attributed to the override that set its parameter, if one did ([`Self::source_of`]).
+    fn attribute(&self, e: ConfigError) -> ConfigError {
+        match e {
+            ConfigError::Key {
+                source_name,
+                key,
+                message,
+            } if source_name == self.source_name => ConfigError::Key {
+                source_name: self.source_of(&key).to_string(),
+                key,
+                message,
+            },
+            e => e,
+        }
+    }
+
+    /// The solver's parameters, checked.
     pub fn sim_params(&self) -> Result<SimParams, ConfigError> {
+        self.sim_params_here().map_err(|e| self.attribute(e))
+    }
+
+    /// The regular motion's six degrees of freedom, checked.
+    pub fn regular(&self) -> Result<[RegularDof; 6], ConfigError> {
+        self.regular_here().map_err(|e| self.attribute(e))
+    }
+
+    /// The irregular motion's six degrees of freedom, checked.
+    pub fn irregular(&self) -> Result<[JonswapDof; 6], ConfigError> {
+        self.irregular_here().map_err(|e| self.attribute(e))
+    }
+
+    /// The solver's parameters.
+    fn sim_params_here(&self) -> Result<SimParams, ConfigError> {
         let c = &self.config;
         let src = self.source_name.as_str();
         let n = c.probes.names.len();
@@ -987,7 +1036,7 @@ impl Loaded {
     }
 
     /// Regular motion per DOF.
-    pub fn regular(&self) -> Result<[RegularDof; 6], ConfigError> {
+    fn regular_here(&self) -> Result<[RegularDof; 6], ConfigError> {
         let r = &self.config.motion.regular;
         let src = &self.source_name;
         let a = six(src, "motion.regular.amplitude", &r.amplitude)?;
@@ -1002,7 +1051,7 @@ impl Loaded {
     }
 
     /// Irregular motion per DOF.
-    pub fn irregular(&self) -> Result<[JonswapDof; 6], ConfigError> {
+    fn irregular_here(&self) -> Result<[JonswapDof; 6], ConfigError> {
         let r = &self.config.motion.irregular;
         let src = &self.source_name;
         let a = six(
@@ -1038,7 +1087,7 @@ impl Loaded {
         let f = &self.config.motion.file;
         if f.is_empty() {
             return Err(key_err(
-                &self.source_name,
+                self.source_of("motion.file"),
                 "motion.file",
                 "motion.source is csv: name a CSV file with header time,x,y,z,roll,pitch,yaw",
             ));
@@ -1135,11 +1184,11 @@ mod tests {
         );
         assert!(err(MIN, &["tank.length=-1"]).contains("tank.length: must be a positive number"));
         assert!(err(MIN, &["record.compression=lz4"])
-            .contains("case.yaml: record.compression: `lz4` is not one of `zstd`, `none`"));
+            .contains("--set: record.compression: `lz4` is not one of `zstd`, `none`"));
         // A spacing typed 1000× too fine: refused before anything is allocated.
         let e = err(MIN, &["particle_spacing=1e-5"]);
         assert!(
-            e.contains("case.yaml: particle_spacing: 0.00001 m makes about")
+            e.contains("--set: particle_spacing: 0.00001 m makes about")
                 && e.contains("use a spacing of at least"),
             "{e}"
         );
@@ -1258,6 +1307,29 @@ mod tests {
         );
         let m = e("solver=3");
         assert!(m.starts_with("-p: solver: "), "{m}");
+        // Range checks too.
+        let checked = |o: &str| {
+            load_node(&files, "/slosh", &[o.to_string()])
+                .unwrap()
+                .sim_params()
+                .unwrap_err()
+                .to_string()
+        };
+        let m = checked("solver.cfl=5");
+        assert!(
+            m.starts_with("-p: solver.cfl: must be within (0, 1]"),
+            "{m}"
+        );
+        let m = checked("solver={cfl: 5}");
+        assert!(
+            m.starts_with("-p: solver.cfl: must be within (0, 1]"),
+            "{m}"
+        );
+        // A parameter the override did not set stays the file's.
+        let m = err(MIN, &["output_rate_hz=20", "fill_height=0.7"]);
+        assert!(m.starts_with("--set: fill_height"), "{m}");
+        let m = err(&MIN.replace("0.39", "0.7"), &["output_rate_hz=20"]);
+        assert!(m.starts_with("case.yaml: fill_height"), "{m}");
         let m = load("seed_tank_039", &["dimension=two".into()])
             .unwrap_err()
             .to_string();

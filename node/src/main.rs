@@ -90,8 +90,8 @@ enum Command {
         /// GIF frames per second.
         #[arg(long, default_value_t = 10.0)]
         fps: f64,
-        /// 3D runs: draw the particles of the layer at y = SLICE (m, tank frame) instead of a side view.
-        #[arg(long)]
+        /// 3D runs: draw the layer of particles nearest y = SLICE (m, tank frame) instead of a side view.
+        #[arg(long, allow_negative_numbers = true)]
         slice: Option<f64>,
         /// Output folder (default: DIR/render).
         #[arg(long)]

@@ -9,11 +9,13 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 pub struct CsvOutputs {
-    probes: BufWriter<File>,
-    wrench: BufWriter<File>,
-    pressure: BufWriter<File>,
-    bodies: Option<BufWriter<File>>,
+    probes: Csv,
+    wrench: Csv,
+    pressure: Csv,
+    bodies: Option<Csv>,
     dir: PathBuf,
+    /// What an earlier run had left in the folder and was removed (see [`CsvOutputs::create`]).
+    pub replaced: Vec<String>,
 }
 
 /// Columns of `bodies.csv`: the body's centre of gravity, orientation (rad), velocities, the liquid's force
@@ -21,18 +23,120 @@ pub struct CsvOutputs {
 pub const BODY_COLUMNS: &str =
     "time,body,x,y,z,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,fx,fy,fz,mx,my,mz,flooded_volume,inflow_rate";
 
-fn create(dir: &Path, name: &str, header: &str) -> std::io::Result<BufWriter<File>> {
-    let path = dir.join(name);
-    let mut w = BufWriter::new(File::create(&path).map_err(|e| {
-        std::io::Error::new(e.kind(), format!("{}: cannot create: {e}", path.display()))
-    })?);
-    writeln!(w, "{header}")?;
-    Ok(w)
+/// One CSV file being written.
+struct Csv {
+    w: BufWriter<File>,
+    path: PathBuf,
+}
+
+impl Csv {
+    fn create(dir: &Path, name: &str, header: &str) -> std::io::Result<Self> {
+        let path = dir.join(name);
+        let mut w = BufWriter::new(File::create(&path).map_err(|e| {
+            std::io::Error::new(e.kind(), format!("{}: cannot create: {e}", path.display()))
+        })?);
+        writeln!(w, "{header}").map_err(|e| named(&path, e))?;
+        Ok(Self { w, path })
+    }
+
+    /// Writes the buffered rows out and closes the file; if that fails, cuts the file after its last whole
+    /// row (a full disk leaves part of a row behind), so that it stays readable.
+    fn close(self) -> std::io::Result<()> {
+        let Self { w, path } = self;
+        match w.into_inner() {
+            Ok(_) => Ok(()),
+            Err(e) => {
+                // The rows that could not be written are dropped, not written again when the writer goes.
+                let (error, (_file, _unwritten)) = (e.error().kind(), e.into_parts());
+                let _ = cut_after_last_row(&path);
+                Err(named(
+                    &path,
+                    std::io::Error::new(error, format!("{error}: cut after its last whole row")),
+                ))
+            }
+        }
+    }
+}
+
+/// `e` with the file it happened to.
+fn named(path: &Path, e: std::io::Error) -> std::io::Error {
+    std::io::Error::new(e.kind(), format!("{}: {e}", path.display()))
+}
+
+/// Truncates a text file after its last newline.
+fn cut_after_last_row(path: &Path) -> std::io::Result<()> {
+    let bytes = std::fs::read(path)?;
+    let keep = bytes.iter().rposition(|b| *b == b'\n').map_or(0, |i| i + 1);
+    if keep < bytes.len() {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)?
+            .set_len(keep as u64)?;
+    }
+    Ok(())
+}
+
+/// Files a run writes into its folder (besides the bag): the CSVs and `summary.json`.
+const RUN_FILES: [&str; 5] = [
+    "probes.csv",
+    "wrench.csv",
+    "pressure.csv",
+    "bodies.csv",
+    "summary.json",
+];
+
+/// Removes, from a folder that holds an earlier run's outputs, what this run would not replace and a user
+/// would take for this run's: its `bodies.csv` (when this run has no bodies), its particle frames (when this
+/// run writes none), and the figures and pictures drawn from them (`slosh plot`'s `plots/`, `slosh
+/// render`'s `render/`). Files of other programs are left alone. Returns what was removed, in words.
+fn clear_earlier_run(dir: &Path, bodies: bool, snapshots: bool) -> std::io::Result<Vec<String>> {
+    if !RUN_FILES.iter().any(|f| dir.join(f).is_file()) {
+        return Ok(Vec::new());
+    }
+    let mut removed = Vec::new();
+    if !bodies && dir.join("bodies.csv").is_file() {
+        std::fs::remove_file(dir.join("bodies.csv"))
+            .map_err(|e| named(&dir.join("bodies.csv"), e))?;
+        removed.push("bodies.csv".to_string());
+    }
+    let mut sweep = |sub: &str, what: &str, ours: &dyn Fn(&str) -> bool| -> std::io::Result<()> {
+        let d = dir.join(sub);
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            return Ok(());
+        };
+        let mut n = 0;
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if e.path().is_file() && ours(&name) {
+                std::fs::remove_file(e.path()).map_err(|err| named(&e.path(), err))?;
+                n += 1;
+            }
+        }
+        if n > 0 {
+            removed.push(format!("{sub}/ ({n} {what})"));
+        }
+        Ok(())
+    };
+    if !snapshots {
+        sweep("snapshots", "particle frame files", &|n| {
+            (n.starts_with("frame_") && n.ends_with(".vtu")) || n == crate::snapshot::SERIES
+        })?;
+    }
+    sweep("plots", "figure files", &|n| {
+        let stem = n.trim_end_matches(".png").trim_end_matches(".svg");
+        n != stem && ["probes", "wrench", "pressure", "bodies"].contains(&stem)
+    })?;
+    sweep("render", "pictures", &|n| {
+        (n.starts_with("frame_") && n.ends_with(".png")) || n == "run.gif"
+    })?;
+    Ok(removed)
 }
 
 impl CsvOutputs {
-    /// Creates the folder and the three CSV files with their headers.
-    pub fn create(dir: &Path, params: &SimParams) -> std::io::Result<Self> {
+    /// Creates the folder and the CSV files with their headers, after removing what an earlier run in the
+    /// same folder left that this run would not replace (its `bodies.csv`, particle frames unless
+    /// `snapshots`, figures and pictures; listed in [`Self::replaced`]).
+    pub fn create(dir: &Path, params: &SimParams, snapshots: bool) -> std::io::Result<Self> {
         std::fs::create_dir_all(dir).map_err(|e| {
             std::io::Error::new(
                 e.kind(),
@@ -42,6 +146,8 @@ impl CsvOutputs {
                 ),
             )
         })?;
+        let bodies = !params.bodies.is_empty() || params.wave_maker.is_some();
+        let replaced = clear_earlier_run(dir, bodies, snapshots)?;
         let names = |v: Vec<&str>| {
             std::iter::once("time")
                 .chain(v)
@@ -49,13 +155,13 @@ impl CsvOutputs {
                 .join(",")
         };
         Ok(Self {
-            probes: create(
+            probes: Csv::create(
                 dir,
                 "probes.csv",
                 &names(params.probes.iter().map(|p| p.name.as_str()).collect()),
             )?,
-            wrench: create(dir, "wrench.csv", "time,fx,fy,fz,mx,my,mz")?,
-            pressure: create(
+            wrench: Csv::create(dir, "wrench.csv", "time,fx,fy,fz,mx,my,mz")?,
+            pressure: Csv::create(
                 dir,
                 "pressure.csv",
                 &names(
@@ -66,12 +172,13 @@ impl CsvOutputs {
                         .collect(),
                 ),
             )?,
-            bodies: if params.bodies.is_empty() && params.wave_maker.is_none() {
-                None
+            bodies: if bodies {
+                Some(Csv::create(dir, "bodies.csv", BODY_COLUMNS)?)
             } else {
-                Some(create(dir, "bodies.csv", BODY_COLUMNS)?)
+                None
             },
             dir: dir.to_path_buf(),
+            replaced,
         })
     }
 
@@ -81,23 +188,25 @@ impl CsvOutputs {
 
     /// Appends one row to each file.
     pub fn write(&mut self, o: &Observation) -> std::io::Result<()> {
-        let row =
-            |w: &mut BufWriter<File>, vals: &mut dyn Iterator<Item = f64>| -> std::io::Result<()> {
-                write!(w, "{:.6}", o.time)?;
-                for v in vals {
-                    write!(w, ",{v:.6e}")?;
-                }
-                writeln!(w)
-            };
+        let row = |c: &mut Csv, vals: &mut dyn Iterator<Item = f64>| -> std::io::Result<()> {
+            let mut line = format!("{:.6}", o.time);
+            for v in vals {
+                line += &format!(",{v:.6e}");
+            }
+            line.push('\n');
+            c.w.write_all(line.as_bytes())
+                .map_err(|e| named(&c.path, e))
+        };
         row(&mut self.probes, &mut o.probes.iter().copied())?;
         row(
             &mut self.wrench,
             &mut o.wrench.force.iter().chain(o.wrench.moment.iter()).copied(),
         )?;
         row(&mut self.pressure, &mut o.pressures.iter().copied())?;
-        if let Some(w) = &mut self.bodies {
+        if let Some(c) = &mut self.bodies {
+            let mut lines = String::new();
             for b in &o.bodies {
-                write!(w, "{:.6},{}", o.time, b.name)?;
+                lines += &format!("{:.6},{}", o.time, b.name);
                 for v in b
                     .position
                     .iter()
@@ -108,21 +217,40 @@ impl CsvOutputs {
                     .chain(&b.moment)
                     .chain([&b.flooded_volume, &b.inflow_rate])
                 {
-                    write!(w, ",{v:.6e}")?;
+                    lines += &format!(",{v:.6e}");
                 }
-                writeln!(w)?;
+                lines.push('\n');
             }
+            c.w.write_all(lines.as_bytes())
+                .map_err(|e| named(&c.path, e))?;
         }
         Ok(())
     }
 
     pub fn flush(&mut self) -> std::io::Result<()> {
-        self.probes.flush()?;
-        self.wrench.flush()?;
-        if let Some(w) = &mut self.bodies {
-            w.flush()?;
+        for c in [&mut self.probes, &mut self.wrench, &mut self.pressure]
+            .into_iter()
+            .chain(self.bodies.as_mut())
+        {
+            c.w.flush().map_err(|e| named(&c.path, e))?;
         }
-        self.pressure.flush()
+        Ok(())
+    }
+
+    /// Writes out and closes every file; a file that cannot be written whole is cut after its last whole row
+    /// (the first such failure is returned).
+    pub fn close(self) -> std::io::Result<()> {
+        let mut first = Ok(());
+        for c in [self.probes, self.wrench, self.pressure]
+            .into_iter()
+            .chain(self.bodies)
+        {
+            let r = c.close();
+            if first.is_ok() {
+                first = r;
+            }
+        }
+        first
     }
 }
 
@@ -160,7 +288,16 @@ pub struct Summary {
     pub parameters: serde_json::Value,
 }
 
+/// Writes `summary.json` whole or not at all (through a temporary file renamed into place: a full disk leaves
+/// no empty or cut summary behind).
 pub fn write_summary(dir: &Path, s: &Summary) -> std::io::Result<()> {
     let text = serde_json::to_string_pretty(s).expect("summary serialises");
-    std::fs::write(dir.join("summary.json"), text + "\n")
+    let (path, tmp) = (dir.join("summary.json"), dir.join(".summary.json.tmp"));
+    let named =
+        |e: std::io::Error| std::io::Error::new(e.kind(), format!("{}: {e}", path.display()));
+    if let Err(e) = std::fs::write(&tmp, text + "\n") {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(named(e));
+    }
+    std::fs::rename(&tmp, &path).map_err(named)
 }

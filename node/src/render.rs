@@ -28,7 +28,8 @@ pub struct RenderOptions {
     pub size: (u32, u32),
     /// GIF frames per second of wall-clock time.
     pub fps: f64,
-    /// 3D: draw only the particles within half a particle spacing of y = this (tank frame, m).
+    /// 3D: draw only the layer of particles nearest y = this (within half a particle spacing of the liquid
+    /// row nearest it; tank frame, m).
     pub slice: Option<f64>,
     /// Output folder (None: `DIR/render`).
     pub out: Option<PathBuf>,
@@ -100,6 +101,15 @@ fn series(dir: &Path) -> Result<(PathBuf, PathBuf), String> {
 /// The particles drawn and the order they are drawn in (back to front): boundary first, then liquid.
 fn visible(s: &Snapshot, f: &Facts, slice: Option<f64>) -> Vec<usize> {
     let dp = f.spacing.unwrap_or(0.01);
+    // The slice is the layer of liquid particles nearest y = Y: the lattice's rows may sit off Y (spread to
+    // fit the tank's breadth, a row's y need not be a multiple of the spacing).
+    let slice = slice.map(|y| {
+        (0..s.len())
+            .filter(|&i| s.is_fluid(i))
+            .map(|i| s.position[i][1] as f64)
+            .min_by(|a, b| (a - y).abs().total_cmp(&(b - y).abs()))
+            .unwrap_or(y)
+    });
     let mut idx: Vec<usize> = (0..s.len())
         .filter(|&i| {
             let p = s.position[i];

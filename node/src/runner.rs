@@ -157,7 +157,14 @@ pub fn drive(
         Some((rc, f)) => Some((Recorder::create(&rc, &parameters)?, f)),
         None => None,
     };
-    let mut outputs = CsvOutputs::create(out, &params)?;
+    let mut outputs = CsvOutputs::create(out, &params, opts.snapshots.is_some())?;
+    if !outputs.replaced.is_empty() {
+        eprintln!(
+            "{}: removed what an earlier run there left and this one would not replace: {}",
+            out.display(),
+            outputs.replaced.join(", ")
+        );
+    }
     let mut snapshots = match &opts.snapshots {
         Some(s) => Some((SnapshotWriter::create(s)?, s.rate_hz)),
         None => None,
@@ -190,7 +197,7 @@ pub fn drive(
     bar.finish_and_clear();
     // The CSVs are flushed and the bag finished on every path, also when the solver stopped; the first
     // failure is the one reported (a bag that failed to write usually fails to finish too).
-    let flushed = outputs.flush();
+    let flushed = outputs.close();
     let recording = record.as_ref().map(|(r, _)| r.dir().display().to_string());
     let finished = record.map_or(Ok(()), |(mut r, _)| r.finish());
     let snapshot_info = snapshots.map(|(w, hz)| {
@@ -248,7 +255,12 @@ pub fn drive(
         }),
         parameters,
     };
-    write_summary(out, &summary)?;
+    // A failed run's own error is the one reported (a full disk fails the summary as well).
+    match (write_summary(out, &summary), &result) {
+        (Err(e), Ok(())) => return Err(e.into()),
+        (Err(e), Err(_)) => eprintln!("slosh: not written: {e}"),
+        (Ok(()), _) => {}
+    }
     match result {
         Ok(()) => Ok(summary),
         Err(LoopError::Solver(error)) => Err(RunError::Solver {
@@ -318,7 +330,7 @@ fn run_loop(
         let t = sim.time();
         if t >= k as f64 / rate - 1e-9 {
             let o = sim.observe(motion).map_err(LoopError::Solver)?;
-            out.write(&o).map_err(LoopError::Io)?;
+            out.write(&o).map_err(|e| at(t, e))?;
             if let Some((r, record)) = rec.as_mut() {
                 record(r, &o).map_err(LoopError::Record)?;
             }
@@ -352,9 +364,17 @@ fn run_loop(
         }
         if last_flush.elapsed() > Duration::from_secs(2) {
             last_flush = Instant::now();
-            out.flush().map_err(LoopError::Io)?;
+            out.flush().map_err(|e| at(sim.time(), e))?;
         }
     }
+}
+
+/// An output error at simulation time `t`.
+fn at(t: f64, e: std::io::Error) -> LoopError {
+    LoopError::Io(std::io::Error::new(
+        e.kind(),
+        format!("writing the outputs at t = {t:.4} s: {e}"),
+    ))
 }
 
 fn progress_bar(enabled: bool, duration: f64) -> ProgressBar {

@@ -380,3 +380,98 @@ fn motion_publisher_rejects_a_start_stamp_that_cannot_be_a_ros_time() {
         );
     }
 }
+
+#[test]
+fn a_run_into_an_earlier_run_s_folder_leaves_nothing_of_it_to_be_taken_for_its_own() {
+    let out = tmp("rerun");
+    // What an earlier run with a floating body, particle frames, figures and pictures left, and a user's file.
+    let earlier = [
+        "bodies.csv",
+        "summary.json",
+        "snapshots/frame_000000.vtu",
+        "snapshots/run.pvd",
+        "plots/probes.png",
+        "plots/probes.svg",
+        "render/frame_000003.png",
+        "render/run.gif",
+    ];
+    for f in earlier.iter().chain(&["notes.txt", "plots/mine.png"]) {
+        let p = out.join(f);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(&p, "earlier\n").unwrap();
+    }
+    let st = slosh()
+        .args(["run", "seed_tank_039", "--out"])
+        .arg(&out)
+        .args(["--duration", "0.05", "--set", "dimension=2"])
+        .args(["--set", "particle_spacing=0.04"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(st.status.success(), "{err}");
+    assert!(
+        err.contains("removed what an earlier run there left")
+            && err.contains("bodies.csv")
+            && err.contains("snapshots/ (2 particle frame files)"),
+        "{err}"
+    );
+    for f in &earlier[2..] {
+        assert!(!out.join(f).exists(), "{f} is still there");
+    }
+    assert!(!out.join("bodies.csv").exists());
+    assert!(std::fs::read_to_string(out.join("summary.json"))
+        .unwrap()
+        .contains("\"steps\""));
+    // Not the run's: left alone.
+    assert!(out.join("notes.txt").exists() && out.join("plots/mine.png").exists());
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn a_full_disk_stops_the_run_naming_the_file_and_leaves_whole_rows() {
+    // A 16 KiB file system of its own (a private mount namespace; as a user, in a user namespace too).
+    let out = tmp("diskfull");
+    std::fs::create_dir_all(&out).unwrap();
+    let bin = env!("CARGO_BIN_EXE_slosh");
+    let script = format!(
+        "mount -t tmpfs -o size=16k tmpfs {d} && {bin} run seed_tank_039 --out {d}/o --duration 5 \
+         --set dimension=2 --set particle_spacing=0.02; echo \"exit $?\"; \
+         cp {d}/o/*.csv {d}/.. 2>/dev/null; true",
+        d = out.join("fs").display()
+    );
+    std::fs::create_dir_all(out.join("fs")).unwrap();
+    let flags = if is_root() { "-m" } else { "-rm" };
+    let st = std::process::Command::new("unshare")
+        .args([flags, "sh", "-c", &script])
+        .output()
+        .unwrap();
+    let (so, se) = (
+        String::from_utf8_lossy(&st.stdout),
+        String::from_utf8_lossy(&st.stderr),
+    );
+    assert!(so.contains("exit 1"), "{so}\n{se}");
+    assert!(
+        se.contains("writing the outputs at t = ")
+            && se.contains("No space left on device")
+            && se.contains(".csv: "),
+        "{se}"
+    );
+    // Every CSV ends in a whole row and reads as a table.
+    for f in ["probes.csv", "wrench.csv", "pressure.csv"] {
+        let text = std::fs::read_to_string(out.join(f)).unwrap();
+        assert!(text.ends_with('\n'), "{f} ends mid-row");
+        let (h, rows) = csv(&out.join(f));
+        assert!(rows.len() > 10, "{f}: {} rows", rows.len());
+        assert!(rows.iter().all(|r| r.len() == h.len()), "{f}: a short row");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Whether this process runs as root (then `unshare -m` needs no user namespace).
+fn is_root() -> bool {
+    std::process::Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+        .unwrap_or(false)
+}

@@ -446,3 +446,40 @@ fn render_without_snapshots_says_how_to_make_them() {
     assert!(!dir.join("zero").exists(), "a refused run left a folder");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_3d_slice_draws_the_layer_nearest_its_y_at_any_spacing() {
+    // At dp 40 mm the seed tank's 0.25 m breadth holds 6 rows 41.7 mm apart, at y = ±20.8 mm, ...: none
+    // within half a spacing of y = 0.
+    let dir = tmp("slice3d");
+    let out = dir.join("run");
+    let st = slosh()
+        .args(["run", "seed_tank_039", "--out"])
+        .arg(&out)
+        .args(["--duration", "0.05", "--snapshots", "20"])
+        .args(["--set", "particle_spacing=0.04"])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    for y in ["0", "0.1", "-0.125"] {
+        let o = slosh()
+            .args(["render"])
+            .arg(&out)
+            .args(["--size", "240x180", "--slice", y, "--out"])
+            .arg(dir.join(format!("r{y}")))
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "--slice {y}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let (share, _) = ink(&image(&dir.join(format!("r{y}/frame_000000.png"))));
+        assert!(share > 0.05, "--slice {y}: {share} inked");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -63,14 +63,14 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
         anyhow::bail!(
             "{}: bodies.{}: floating bodies are not served over iceoryx2 yet (their motion has no place in \
              the step reply); run the case with `slosh run` or `slosh node`",
-            cfg.source_name,
+            cfg.source_of("bodies"),
             b.name
         );
     }
     if params.wave_maker.is_some() {
         anyhow::bail!(
             "{}: wave_maker: not served over iceoryx2 yet; run the case with `slosh run` or `slosh node`",
-            cfg.source_name
+            cfg.source_of("wave_maker")
         );
     }
     let tp = cfg.config.frames.tank_pose;
@@ -84,7 +84,17 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
     };
     let mut sim = sph::build(params.clone())?;
     let mut csv = match &opts.out {
-        Some(d) => Some(CsvOutputs::create(d, &params)?),
+        Some(d) => {
+            let c = CsvOutputs::create(d, &params, false)?;
+            if !c.replaced.is_empty() {
+                eprintln!(
+                    "slosh couple: {}: removed what an earlier run there left and this one would not replace: {}",
+                    d.display(),
+                    c.replaced.join(", ")
+                );
+            }
+            Some(c)
+        }
         None => None,
     };
 
@@ -182,8 +192,8 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
             }
         }
     };
-    if let Some(mut c) = csv {
-        c.flush()?;
+    if let Some(c) = csv {
+        c.close()?;
     }
     result.map(|()| served)
 }

@@ -368,28 +368,28 @@ pub fn run(
     if !(c.motion_timeout_s.is_finite() && c.motion_timeout_s > 0.0) {
         anyhow::bail!(
             "{}: motion_timeout_s: must be a positive number of seconds, got {}",
-            cfg.source_name,
+            cfg.source_of("motion_timeout_s"),
             c.motion_timeout_s
         );
     }
     if !(c.input.max_gap_s.is_finite() && c.input.max_gap_s > 0.0) {
         anyhow::bail!(
             "{}: input.max_gap_s: must be a positive number of seconds, got {}",
-            cfg.source_name,
+            cfg.source_of("input.max_gap_s"),
             c.input.max_gap_s
         );
     }
     if !(c.diagnostics_rate_hz.is_finite() && c.diagnostics_rate_hz > 0.0) {
         anyhow::bail!(
             "{}: diagnostics_rate_hz: must be a positive number of messages per second, got {}",
-            cfg.source_name,
+            cfg.source_of("diagnostics_rate_hz"),
             c.diagnostics_rate_hz
         );
     }
     if !(c.particles.rate_hz.is_finite() && c.particles.rate_hz >= 0.0) {
         anyhow::bail!(
             "{}: particles.rate_hz: must be zero (off) or a positive number of clouds per simulated second, got {}",
-            cfg.source_name,
+            cfg.source_of("particles.rate_hz"),
             c.particles.rate_hz
         );
     }
@@ -413,7 +413,7 @@ pub fn run(
     {
         anyhow::bail!(
             "{}: input.world_frame / input.body_frame: iceoryx2 motion samples are always in a z-up world and the FLU vessel frame; leave both at enu / flu",
-            cfg.source_name
+            cfg.source_of("input.world_frame")
         );
     }
     if iox_on {
@@ -426,7 +426,7 @@ pub fn run(
     if !(iox.dds_outputs || iox.outputs || iox.particles) {
         anyhow::bail!(
             "{}: iceoryx2.dds_outputs: false publishes nothing; set iceoryx2.outputs: true (and iceoryx2.particles) or leave dds_outputs true",
-            cfg.source_name
+            cfg.source_of("iceoryx2.dds_outputs")
         );
     }
     let iox_node = if iox_on {
@@ -498,7 +498,7 @@ pub fn run(
     if iox.particles && c.particles.rate_hz <= 0.0 {
         anyhow::bail!(
             "{}: iceoryx2.particles: set particles.rate_hz (frames per simulated second) above 0",
-            cfg.source_name
+            cfg.source_of("iceoryx2.particles")
         );
     }
     let pub_cloud: Option<Publisher<PointCloud2>> = if c.particles.rate_hz > 0.0 && iox.dds_outputs
