@@ -831,10 +831,14 @@ pub fn apply_override(params: &mut Value, o: &str) -> Result<(), (String, String
         Value::String(String::new())
     } else {
         serde_saphyr::from_str(raw).map_err(|e| {
-            (
-                key.to_string(),
-                format!("value `{raw}` is not valid YAML: {}", for_the_user(&e)),
-            )
+            (key.to_string(), {
+                let why = for_the_user(&e);
+                if why.contains("(parameters must be finite numbers)") {
+                    format!("value `{raw}`: parameters must be finite numbers")
+                } else {
+                    format!("value `{raw}` is not valid YAML: {why}")
+                }
+            })
         })?
     };
     let mut node = params;
@@ -1203,9 +1207,9 @@ mod tests {
         );
         let e = err(MIN, &["solver.cfl=.nan"]);
         assert!(
-            e.contains("solver.cfl: value `.nan` is not valid YAML")
-                && e.contains("(parameters must be finite numbers)")
-                && !e.contains("policy"),
+            e.contains("solver.cfl: value `.nan`: parameters must be finite numbers")
+                && !e.contains("policy")
+                && !e.contains("not valid YAML"),
             "{e}"
         );
         let e = err(&format!("{MIN}    dimension: 3\n"), &[]);

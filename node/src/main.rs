@@ -22,7 +22,7 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
         /// Simulated seconds (default: the config's `duration`).
-        #[arg(long)]
+        #[arg(long, value_parser = positive_seconds)]
         duration: Option<f64>,
         /// Override a parameter by its dotted name, value as YAML: --set solver.cfl=0.15 --set probes.x=[-0.3,0.0]
         #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -53,7 +53,7 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Simulated seconds (default: the whole recorded motion).
-        #[arg(long)]
+        #[arg(long, value_parser = positive_seconds)]
         duration: Option<f64>,
         /// Override a parameter by its dotted name, value as YAML: --set replay.bad_samples=drop
         #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -129,7 +129,7 @@ enum Command {
         #[arg(long)]
         case: Vec<String>,
         /// Simulated seconds per case (default: each case's own).
-        #[arg(long)]
+        #[arg(long, value_parser = positive_seconds)]
         duration: Option<f64>,
         /// Override a setting of every case after its own (`--set solver.dfsph.max_density_error=1e-3`).
         #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -165,7 +165,7 @@ enum Command {
     /// Run as a ROS 2 node: `slosh node --ros-args --params-file CASE.yaml [-p name:=value] [-r from:=to]`.
     Node {
         /// Stop after this many simulated seconds (default: run until SIGINT/SIGTERM).
-        #[arg(long)]
+        #[arg(long, value_parser = positive_seconds)]
         duration: Option<f64>,
         /// ROS arguments (`--ros-args ...`); a plain first argument names the parameters file or built-in case.
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
@@ -179,7 +179,7 @@ enum Command {
         #[arg(long, default_value_t = 50.0)]
         rate: f64,
         /// Seconds of motion.
-        #[arg(long, default_value_t = 10.0)]
+        #[arg(long, value_parser = positive_seconds, default_value_t = 10.0)]
         duration: f64,
         /// Also publish geometry_msgs/PoseStamped on `motion/pose`.
         #[arg(long)]
@@ -335,9 +335,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let out = out.unwrap_or_else(|| beside(&bag, "_repaired"));
             let r = slosh_node::record::repair(&bag, &out)?;
             println!(
-                "recovered {} messages on {} topics from {} file{} into {}{}",
+                "recovered {} message{} on {} topic{} from {} file{} into {}{}",
                 r.messages,
+                if r.messages == 1 { "" } else { "s" },
                 r.topics,
+                if r.topics == 1 { "" } else { "s" },
                 r.files,
                 if r.files == 1 { "" } else { "s" },
                 out.display(),
@@ -654,4 +656,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// A `--duration`: a positive, finite number of seconds.
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(v) => Err(format!("must be a positive number of seconds, got {v}")),
+        Err(e) => Err(format!("not a number of seconds: {e}")),
+    }
 }

@@ -68,7 +68,14 @@ fn walk(path: &str, value: Value, out: &mut Vec<Section>) -> Result<(), String> 
             }
             Ok(())
         }
-        None => Err(missing()),
+        // Parameters under a key that is not `ros__parameters` (`parameters:`, a typo) one level down.
+        None => match path.rsplit_once('/') {
+            Some((parent, last)) if !parent.is_empty() => Err(format!(
+                "{path}: parameter values under `{last}:`, not `{PARAMS_KEY}:` (the layout is \
+                 `{parent}: {{{PARAMS_KEY}: {{...}}}}`)"
+            )),
+            _ => Err(missing()),
+        },
     }
 }
 
@@ -156,6 +163,11 @@ mod tests {
         assert!(e(json!({"slosh": {}})).contains("slosh: missing `ros__parameters:`"));
         assert!(e(json!({"slosh": {"dimension": 2}})).contains("slosh: missing `ros__parameters:`"));
         assert!(e(json!({"slosh": 3})).contains("expected `ros__parameters:` under the node name"));
+        let m = e(json!({"/**": {"parameters": {"dimension": 2}}}));
+        assert!(
+            m.contains("/**/parameters: parameter values under `parameters:`, not `ros__parameters:` (the layout is `/**: {ros__parameters: {...}}`)"),
+            "{m}"
+        );
         assert!(
             e(json!({"slosh": {"ros__parameters": 3}})).contains("expected a map of parameters")
         );

@@ -436,6 +436,21 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
     }
     let topics = rec.channels.len();
     rec.finish()?;
+    if n == 0 {
+        // An empty bag would pass for a repaired one.
+        let _ = std::fs::remove_dir_all(out);
+        return Err(bad(
+            input,
+            format!(
+                "no whole message to recover{}; no bag written",
+                if stops.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", stops.join("; "))
+                }
+            ),
+        ));
+    }
     Ok(Repaired {
         messages: n,
         topics,
@@ -541,6 +556,53 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("missing.mcap: no such file or folder"), "{e}");
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn a_damaged_file_of_a_split_bag_is_repaired_with_its_folder() {
+        let d = tmp("split-hint");
+        let split = d.join("split");
+        std::fs::create_dir_all(&split).unwrap();
+        for (i, ts) in [(0, &[1, 2][..]), (1, &[3, 4, 5])] {
+            let f = bag(&d.join(format!("part{i}")), ts);
+            std::fs::rename(f, split.join(format!("split_{i}.mcap"))).unwrap();
+        }
+        let first = split.join("split_0.mcap");
+        let bytes = std::fs::read(&first).unwrap();
+        std::fs::write(&first, &bytes[..bytes.len() * 2 / 3]).unwrap();
+        let files = [first.clone(), split.join("split_1.mcap")];
+        let e = crate::replay::bag::for_each_message(&files, |_| Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("`slosh bag repair {}`", split.display())),
+            "{e}"
+        );
+        // One file alone: that file.
+        let e = crate::replay::bag::for_each_message(&files[..1], |_| Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("`slosh bag repair {}`", first.display())),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn repair_that_recovers_nothing_fails_and_writes_nothing() {
+        let d = tmp("nothing");
+        let f = bag(&d.join("whole"), &[1, 2, 3]);
+        let cut = d.join("cut.mcap");
+        std::fs::write(&cut, &std::fs::read(&f).unwrap()[..100]).unwrap();
+        let out = d.join("cut_repaired");
+        let e = repair(&cut, &out).unwrap_err().to_string();
+        assert!(
+            e.contains("cut.mcap: no whole message to recover") && e.contains("no bag written"),
+            "{e}"
+        );
+        assert!(!out.exists());
         let _ = std::fs::remove_dir_all(&d);
     }
 

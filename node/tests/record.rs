@@ -45,7 +45,8 @@ fn a_recording_is_read_by_rosbags_and_mcap_with_the_values_written() {
     let probes = common::csv(&dir.join("out/probes.csv")).1;
     for reader in ["rosbags", "mcap"] {
         let topics = v[reader].as_object().unwrap();
-        let names: Vec<&String> = topics.keys().collect();
+        let mut names: Vec<&String> = topics.keys().collect();
+        names.sort();
         assert_eq!(
             names,
             ["/motion/odom", "/pressures", "/probes", "/wrench"],

@@ -37,6 +37,16 @@ pub fn read(path: &Path) -> Result<Table, String> {
         .next()
         .ok_or_else(|| format!("{p}: empty file (expected a header row: time,<columns>)"))?;
     let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
+    if let Some((i, n)) = names
+        .iter()
+        .enumerate()
+        .find(|(i, n)| names[..*i].contains(n))
+    {
+        return Err(format!(
+            "{p}: column {} is named `{n}` like an earlier one: each column needs its own name",
+            i + 1
+        ));
+    }
     let t_col = names
         .iter()
         .position(|n| {
@@ -123,5 +133,10 @@ mod tests {
         let e = table("time,p1\n0.0\n").unwrap_err();
         assert!(e.contains(":2:") && e.contains("1 fields"), "{e}");
         assert!(table("time,p1\n").unwrap_err().contains("no rows"));
+        let e = table("time,p24,p24\n0,1,2\n").unwrap_err();
+        assert!(
+            e.contains("column 3 is named `p24` like an earlier one"),
+            "{e}"
+        );
     }
 }

@@ -133,7 +133,11 @@ pub fn for_each_message(
                     file,
                     format!(
                         "truncated or corrupt after {n} messages ({e}); `slosh bag repair {}` recovers the messages of its complete chunks into a new bag",
-                        file.display()
+                        // A split bag is repaired whole: its other files' messages too.
+                        match (files.len() > 1, file.parent()) {
+                            (true, Some(dir)) => dir.display(),
+                            _ => file.display(),
+                        }
                     ),
                 )
             })?;

@@ -361,15 +361,14 @@ fn build(
     for (i, d) in decoded.iter().enumerate() {
         let t = (time_ns(d) - t0_ns) as f64 * 1e-9;
         let accepted = match &d.reading {
-            R::Pose(p) => {
-                let c = tank_coordinates(p, how.frames);
+            R::Pose(p) => tank_coordinates(p, how.frames).and_then(|c| {
                 let prev = times.last().copied().zip(poses.last().copied());
                 check_pose(prev, t, &c, &how.limits).map(|()| {
                     times.push(t);
                     poses.push(c);
                 })
-            }
-            R::Imu(m) => imu.push(t, imu_sample(m, how.frames)),
+            }),
+            R::Imu(m) => imu_sample(m, how.frames).and_then(|s| imu.push(t, s)),
             R::State(_) => unreachable!("bags are decoded to poses or IMU readings"),
         };
         match accepted {

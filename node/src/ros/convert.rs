@@ -36,8 +36,8 @@ pub fn position(p: &Point) -> Vector3<f64> {
     Vector3::new(p.x, p.y, p.z)
 }
 
-/// The rotation a message's quaternion stands for. A zero quaternion (orientation unset) normalises to NaN,
-/// which the sample checks reject by name.
+/// The rotation a message's quaternion stands for. A zero quaternion (orientation unset) normalises to NaN;
+/// received samples are checked for it first (`live::tank_coordinates`, `live::imu_sample`).
 pub fn unit(q: &QuatMsg) -> UnitQuaternion<f64> {
     let q = Quaternion::new(q.w, q.x, q.y, q.z);
     UnitQuaternion::new_unchecked(q / q.norm())

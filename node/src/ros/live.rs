@@ -8,7 +8,7 @@ use super::live_imu::{ImuSample, LiveImu};
 use super::live_motion::{Limits, LiveMotion, Rejected};
 use super::live_state::LiveState;
 use nalgebra::{UnitQuaternion, Vector3};
-use slosh_msgs::geometry_msgs::{Pose, Vector3 as Vec3Msg};
+use slosh_msgs::geometry_msgs::{Pose, Quaternion as QuatMsg, Vector3 as Vec3Msg};
 use slosh_msgs::sensor_msgs::Imu;
 use sph::motion::{RigidState, TankMotion};
 
@@ -22,17 +22,46 @@ pub enum Reading {
 }
 
 /// The tank's six coordinates (x, y, z, roll, pitch, yaw) from a received vessel pose.
-pub fn tank_coordinates(p: &Pose, frames: &Frames) -> [f64; 6] {
-    frames.tank_coordinates(position(&p.position), unit(&p.orientation))
+pub fn tank_coordinates(p: &Pose, frames: &Frames) -> Result<[f64; 6], Rejected> {
+    orientation(&p.orientation)?;
+    Ok(frames.tank_coordinates(position(&p.position), unit(&p.orientation)))
 }
 
 /// An IMU reading in the vessel's FLU frame and the ENU world, from one received.
-pub fn imu_sample(i: &Imu, frames: &Frames) -> ImuSample {
-    ImuSample {
+pub fn imu_sample(i: &Imu, frames: &Frames) -> Result<ImuSample, Rejected> {
+    if i.orientation_covariance[0] == -1.0 {
+        return Err(Rejected::Invalid(
+            "orientation: this IMU gives none (orientation_covariance[0] = -1); the IMU input needs the \
+             vessel's orientation (an AHRS or a filter's output), or use input.type: odom"
+                .into(),
+        ));
+    }
+    orientation(&i.orientation)?;
+    Ok(ImuSample {
         orientation: frames.vessel_orientation(unit(&i.orientation)),
         angular_velocity: frames.body_vector(vector(&i.angular_velocity)),
         specific_force: frames.body_vector(vector(&i.linear_acceleration)),
+    })
+}
+
+/// A received orientation that is a rotation: finite, and not the zero quaternion of an orientation left
+/// unset (any other length is normalised, as ROS tools do).
+fn orientation(q: &QuatMsg) -> Result<(), Rejected> {
+    let c = [q.x, q.y, q.z, q.w];
+    if !c.iter().all(|v| v.is_finite()) {
+        return Err(Rejected::NotFinite {
+            what: "orientation (quaternion)",
+        });
     }
+    let n = c.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if n < 1e-6 {
+        return Err(Rejected::Invalid(format!(
+            "orientation: the quaternion (x, y, z, w) = ({}, {}, {}, {}) has no length: an orientation left \
+             unset? (the identity is (0, 0, 0, 1))",
+            q.x, q.y, q.z, q.w
+        )));
+    }
+    Ok(())
 }
 
 /// Received motion of either kind.
@@ -140,8 +169,8 @@ impl Live {
     /// Adds a sample at time `t`, converted by `frames`.
     pub fn push(&mut self, t: f64, r: &Reading, frames: &Frames) -> Result<(), Rejected> {
         match (self, r) {
-            (Live::Pose(m, _), Reading::Pose(p)) => m.push(t, tank_coordinates(p, frames)),
-            (Live::Imu(m), Reading::Imu(i)) => m.push(t, imu_sample(i, frames)),
+            (Live::Pose(m, _), Reading::Pose(p)) => m.push(t, tank_coordinates(p, frames)?),
+            (Live::Imu(m), Reading::Imu(i)) => m.push(t, imu_sample(i, frames)?),
             (Live::State(m, mount), Reading::State(s)) => {
                 crate::iox::check(s).map_err(Rejected::Invalid)?;
                 m.push(t, crate::iox::tank_state(s, mount))
@@ -210,6 +239,31 @@ mod tests {
     use crate::ros::convert::{point_msg, quat_msg, vec3_msg};
     use crate::ros::frames::{BodyFrame, TankPose, WorldFrame};
     use sph::motion::{Dof6Motion, RegularDof, RegularMotion};
+
+    #[test]
+    fn an_unset_or_non_finite_orientation_is_named() {
+        let frames = Frames::new(WorldFrame::Enu, BodyFrame::Flu, TankPose::default());
+        let mut p = Pose::default();
+        let e = tank_coordinates(&p, &frames).unwrap_err().to_string();
+        assert!(
+            e.starts_with("orientation: the quaternion") && e.contains("has no length"),
+            "{e}"
+        );
+        p.orientation.w = f64::NAN;
+        let e = tank_coordinates(&p, &frames).unwrap_err().to_string();
+        assert_eq!(e, "orientation (quaternion) is not a finite number");
+        // Not of unit length: normalised.
+        p.orientation.w = 2.0;
+        assert_eq!(tank_coordinates(&p, &frames).unwrap(), [0.0; 6]);
+        let mut i = Imu::default();
+        assert!(imu_sample(&i, &frames).is_err());
+        i.orientation_covariance[0] = -1.0;
+        let e = imu_sample(&i, &frames).unwrap_err().to_string();
+        assert!(
+            e.contains("this IMU gives none (orientation_covariance[0] = -1)"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn measured_accelerations_replace_the_splines_and_carry_the_lever_arm() {
