@@ -27,6 +27,8 @@ pub const BODY_COLUMNS: &str =
 struct Csv {
     w: BufWriter<File>,
     path: PathBuf,
+    /// A write failed: what reached the file may end inside a row.
+    failed: bool,
 }
 
 impl Csv {
@@ -36,22 +38,36 @@ impl Csv {
             std::io::Error::new(e.kind(), format!("{}: cannot create: {e}", path.display()))
         })?);
         writeln!(w, "{header}").map_err(|e| named(&path, e))?;
-        Ok(Self { w, path })
+        Ok(Self {
+            w,
+            path,
+            failed: false,
+        })
+    }
+
+    /// Appends whole lines.
+    fn append(&mut self, lines: &str) -> std::io::Result<()> {
+        self.w.write_all(lines.as_bytes()).map_err(|e| {
+            self.failed = true;
+            named(&self.path, e)
+        })
     }
 
     /// Writes the buffered rows out and closes the file; if that fails, cuts the file after its last whole
     /// row (a full disk leaves part of a row behind), so that it stays readable.
     fn close(self) -> std::io::Result<()> {
-        let Self { w, path } = self;
+        let Self { w, path, failed } = self;
         match w.into_inner() {
-            Ok(_) => Ok(()),
+            Ok(_) if !failed => Ok(()),
+            Ok(_) => cut_after_last_row(&path).map_err(|e| named(&path, e)),
             Err(e) => {
+                let (kind, message) = (e.error().kind(), e.error().to_string());
                 // The rows that could not be written are dropped, not written again when the writer goes.
-                let (error, (_file, _unwritten)) = (e.error().kind(), e.into_parts());
+                let (_file, _unwritten) = e.into_parts();
                 let _ = cut_after_last_row(&path);
                 Err(named(
                     &path,
-                    std::io::Error::new(error, format!("{error}: cut after its last whole row")),
+                    std::io::Error::new(kind, format!("{message} (cut after its last whole row)")),
                 ))
             }
         }
@@ -194,8 +210,7 @@ impl CsvOutputs {
                 line += &format!(",{v:.6e}");
             }
             line.push('\n');
-            c.w.write_all(line.as_bytes())
-                .map_err(|e| named(&c.path, e))
+            c.append(&line)
         };
         row(&mut self.probes, &mut o.probes.iter().copied())?;
         row(
@@ -221,8 +236,7 @@ impl CsvOutputs {
                 }
                 lines.push('\n');
             }
-            c.w.write_all(lines.as_bytes())
-                .map_err(|e| named(&c.path, e))?;
+            c.append(&lines)?;
         }
         Ok(())
     }
