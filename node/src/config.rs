@@ -1036,6 +1036,42 @@ impl Loaded {
                 format!("must be a positive number of seconds, got {}", c.duration),
             ));
         }
+        // The input's plausibility limits: at 0 or below every sample would be refused as a jump.
+        for (key, v, unit) in [
+            ("input.max_speed", c.input.max_speed, "m/s"),
+            (
+                "input.max_rotation_rate",
+                c.input.max_rotation_rate,
+                "rad/s",
+            ),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(key_err(
+                    src,
+                    key,
+                    format!("must be a positive speed in {unit} (samples that move faster are refused), got {v}"),
+                ));
+            }
+        }
+        if c.particles.decimation == 0 {
+            return Err(key_err(
+                src,
+                "particles.decimation",
+                "must be 1 (every particle) or more (every n-th), got 0",
+            ));
+        }
+        for (key, name) in [
+            ("frames.tank", &c.frames.tank),
+            ("frames.vessel", &c.frames.vessel),
+        ] {
+            if name.trim().is_empty() {
+                return Err(key_err(
+                    src,
+                    key,
+                    "the frame's name may not be empty (it is the messages' frame_id and a tf frame)",
+                ));
+            }
+        }
         Ok(p)
     }
 
@@ -1187,6 +1223,14 @@ mod tests {
             err(MIN, &["output_rate_hz=0"]).contains("output_rate_hz: must be a positive number")
         );
         assert!(err(MIN, &["tank.length=-1"]).contains("tank.length: must be a positive number"));
+        assert!(err(MIN, &["input.max_speed=-1"])
+            .contains("--set: input.max_speed: must be a positive speed in m/s"));
+        assert!(
+            err(MIN, &["input.max_rotation_rate=0"]).contains("input.max_rotation_rate: must be")
+        );
+        assert!(err(MIN, &["particles.decimation=0"]).contains("particles.decimation: must be 1"));
+        assert!(err(MIN, &["frames.tank=''"])
+            .contains("frames.tank: the frame's name may not be empty"));
         assert!(err(MIN, &["record.compression=lz4"])
             .contains("--set: record.compression: `lz4` is not one of `zstd`, `none`"));
         // A spacing typed 1000× too fine: refused before anything is allocated.

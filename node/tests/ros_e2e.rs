@@ -316,6 +316,16 @@ fn compare_with_run_on(kind: &str, domain_id: u16, ranks: usize) {
         diag.iter().any(|d| d[1][1] == "running"),
         "recorded diagnostics: {diag:?}"
     );
+    // The static frames once (a player of the bag needs them), read by both readers.
+    for reader in ["rosbags", "mcap"] {
+        let tf = bag[reader]["/tf_static"]["items"].as_array().unwrap();
+        assert_eq!(tf.len(), 1, "{reader}: {tf:?}");
+        let frames = tf[0][1].as_array().unwrap();
+        assert!(
+            frames.iter().any(|f| f[1] == "tank") && frames.len() >= 3,
+            "{reader}: {frames:?}"
+        );
+    }
     let clouds = bag["rosbags"]["/ship1/particles"]["items"]
         .as_array()
         .unwrap();
@@ -854,6 +864,79 @@ fn receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping() {
     };
     let (accepted, rejected) = (num(" samples accepted"), num(" rejected"));
     assert!(rejected == 0 && accepted >= sent - 5, "{counts}\n{log}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_solver_failure_is_in_the_recording_with_its_diagnostics() {
+    if !common::in_private_netns("a_solver_failure_is_in_the_recording_with_its_diagnostics") {
+        return;
+    }
+    let dir = common::tmp("ros-failure");
+    let case = dir.join("case.yaml");
+    // Shaken 0.4 m at 4 Hz: the time step collapses within a second.
+    std::fs::write(
+        &case,
+        common::small_case(
+            "    motion:\n      source: regular\n      regular: {amplitude: [0.4, 0, 0.3, 0, 0, 0], period: [0.25, 0, 0.2, 0, 0, 0], phase: [0, 0, 0, 0, 0, 0]}\n",
+        ),
+    )
+    .unwrap();
+    let bag = dir.join("bag");
+    let mut node = Kill(
+        slosh()
+            .args(["node", "--duration", "5", "--ros-args", "--params-file"])
+            .arg(&case)
+            .args(["-p", "particle_spacing:=0.04", "-p"])
+            .arg(format!("record.path:={}", bag.display()))
+            .env("ROS_DOMAIN_ID", "46")
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let _motion = Kill(
+        slosh()
+            .arg("motion")
+            .arg(&case)
+            .args([
+                "--rate",
+                "50",
+                "--duration",
+                "6",
+                "--wait-for-subscribers",
+                "1",
+            ])
+            .env("ROS_DOMAIN_ID", "46")
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    let start = Instant::now();
+    let status = loop {
+        if let Some(st) = node.0.try_wait().unwrap() {
+            break st;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(90),
+            "the node neither failed nor finished"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let mut log = String::new();
+    std::io::Read::read_to_string(&mut node.0.stderr.take().unwrap(), &mut log).unwrap();
+    assert!(!status.success() && log.contains("solver stopped"), "{log}");
+    // The recording is finished, and its last diagnostics are the failure's (ERROR, with the reason).
+    let v = common::read_bag(&bag);
+    for reader in ["rosbags", "mcap"] {
+        let diag = v[reader]["/diagnostics"]["items"].as_array().unwrap();
+        let last = &diag.last().unwrap()[1];
+        assert_eq!(last[0], 2, "{reader}: {diag:?}");
+        let reason = last[1].as_str().unwrap();
+        assert!(
+            log.contains(reason),
+            "{reader}: `{reason}` not in the log: {log}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

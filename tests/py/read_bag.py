@@ -31,6 +31,8 @@ def summarize(topic, msg):
         st = msg.status[0]
         level = st.level[0] if isinstance(st.level, (bytes, bytearray)) else int(st.level)
         return [level, st.message]
+    if hasattr(msg, "transforms"):
+        return [[t.header.frame_id, t.child_frame_id] for t in msg.transforms]
     if hasattr(msg, "point_step"):
         return [msg.width, msg.height, msg.point_step]
     if hasattr(msg, "pose") and hasattr(msg, "twist"):

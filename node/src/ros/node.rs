@@ -581,6 +581,7 @@ pub fn run(
         names.resolve("pressures")?,
     ];
     let diag_topic = names.resolve("/diagnostics")?;
+    let tf_topic = names.resolve("/tf_static")?;
     let cloud_topic = names.resolve("particles")?;
     let mut recorder = if c.record.path.is_empty() {
         None
@@ -856,8 +857,13 @@ pub fn run(
             continue;
         };
         if !tf_sent {
+            let tf = static_transforms(&cfg, &params, Time::from_secs_f64(base));
+            // Recorded too: a player of the bag (Foxglove, `ros2 bag play`) needs the frames.
+            if let Some(r) = recorder.as_mut() {
+                r.write(&tf_topic, Time::from_secs_f64(base), &tf)?;
+            }
             pub_tf
-                .publish(static_transforms(&cfg, &params, Time::from_secs_f64(base)))
+                .publish(tf)
                 .map_err(|e| anyhow::anyhow!("publishing /tf_static: {e:?}"))?;
             tf_sent = true;
         }
@@ -1052,15 +1058,13 @@ pub fn run(
         }
     }
     // The recording is finished on every way out (errors included; Drop covers early returns).
-    if let Some(mut r) = recorder.take() {
-        r.finish()?;
-    }
-    if let Some(e) = &error {
+    // A solver failure's diagnostics go into the recording too, before it is finished.
+    let failure = error.as_ref().map(|e| {
         log(
             ros2_client::ros2::LogLevel::Fatal,
             &format!("solver stopped: {e}"),
         );
-        let d = diagnostics(
+        diagnostics(
             &full_name,
             t0.map(|b| b + sim.time()),
             &pacing,
@@ -1068,7 +1072,15 @@ pub fn run(
             sim.as_ref(),
             e,
             wall(),
-        );
+        )
+    });
+    if let Some(mut r) = recorder.take() {
+        if let Some(d) = failure.as_ref().filter(|d| d.header.stamp.as_nanos() > 0) {
+            let _ = r.write(&diag_topic, d.header.stamp, d);
+        }
+        r.finish()?;
+    }
+    if let (Some(e), Some(d)) = (&error, failure) {
         let _ = pub_diag.publish(d);
         anyhow::bail!("solver stopped at t = {:.4} s: {e}", sim.time());
     }
