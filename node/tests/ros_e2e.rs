@@ -11,7 +11,7 @@ use ros2_client::{
 };
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::DiagnosticArray;
-use slosh_msgs::geometry_msgs::WrenchStamped;
+use slosh_msgs::geometry_msgs::{Accel, AccelStamped, Vector3, WrenchStamped};
 use slosh_msgs::geometry_msgs::{Pose, PoseWithCovariance, Quaternion, TwistWithCovariance};
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
@@ -864,6 +864,76 @@ fn receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping() {
     };
     let (accepted, rejected) = (num(" samples accepted"), num(" rejected"));
     assert!(rejected == 0 && accepted >= sent - 5, "{counts}\n{log}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn accelerations_on_another_clock_than_the_motion_are_rejected_and_said() {
+    if !common::in_private_netns(
+        "accelerations_on_another_clock_than_the_motion_are_rejected_and_said",
+    ) {
+        return;
+    }
+    let dir = common::tmp("ros-accel-clock");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case("    input: {accel: true}\n")).unwrap();
+    let (_ctx, mut node) = test_node(48, "e2e_accel_clock");
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
+    let accel = publisher::<AccelStamped>(&mut node, "/motion", "accel", &qos);
+    let proc = slosh()
+        .args(["node", "--ros-args", "--params-file"])
+        .arg(&case)
+        .env("ROS_DOMAIN_ID", "48")
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let seen = Instant::now();
+    while node.subscription_count("/motion/odom") == 0
+        || node.subscription_count("/motion/accel") == 0
+    {
+        assert!(
+            seen.elapsed() < Duration::from_secs(30),
+            "the node never subscribed"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    // The motion stamped from 1000 s, its accelerations from 0 s (a second clock).
+    for k in 0..60 {
+        let t = k as f64 * 0.02;
+        let _ = odom.publish(rest_odometry(1000.0 + t));
+        let _ = accel.publish(AccelStamped {
+            header: Header {
+                stamp: Time::from_secs_f64(t),
+                frame_id: "base_link".into(),
+            },
+            accel: Accel {
+                linear: Vector3 {
+                    x: 2.0,
+                    y: 0.0,
+                    z: 0.0,
+                },
+                angular: Vector3::default(),
+            },
+        });
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let pid = proc.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let out = proc.wait_with_output().unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{log}");
+    assert!(
+        log.contains("rejected an acceleration sample: stamp 0.")
+            && log.contains("AccelStamped must carry the motion's time stamps"),
+        "{log}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

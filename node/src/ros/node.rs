@@ -812,10 +812,36 @@ pub fn run(
         }
         if let (Some(sa), Some(base)) = (&sub_accel, t0) {
             while let Ok(Some((m, _))) = sa.take() {
-                let t = m.header.stamp.as_secs_f64() - base;
-                if let Err(e) = motion.push_accel(t, &m.accel.linear, &m.accel.angular, &frames) {
+                let stamp = m.header.stamp.as_secs_f64();
+                let t = stamp - base;
+                // Accelerations stamped on another clock than the motion would never cover the times the
+                // solver asks for: they would be kept and silently never used.
+                let off = motion
+                    .newest()
+                    .map(|n| t - n)
+                    .filter(|d| d.abs() > c.input.max_gap_s);
+                let pushed = match off {
+                    Some(d) => Err(format!(
+                        "stamp {stamp:.6} s is {d:.3} s from the newest motion sample's (more than input.max_gap_s = {}): AccelStamped must carry the motion's time stamps",
+                        c.input.max_gap_s
+                    )),
+                    None => motion
+                        .push_accel(t, &m.accel.linear, &m.accel.angular, &frames)
+                        .map_err(|e| e.to_string()),
+                };
+                if let Err(e) = pushed {
                     counters.rejected += 1;
                     counters.last_reject = format!("motion/accel: {e}");
+                    if wall() - last_warn > 1.0 {
+                        last_warn = wall();
+                        log(
+                            ros2_client::ros2::LogLevel::Warn,
+                            &format!(
+                                "rejected an acceleration sample: {e} ({} rejected so far)",
+                                counters.rejected
+                            ),
+                        );
+                    }
                 }
             }
         }
