@@ -864,6 +864,41 @@ fn receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping() {
     };
     let (accepted, rejected) = (num(" samples accepted"), num(" rejected"));
     assert!(rejected == 0 && accepted >= sent - 5, "{counts}\n{log}");
+
+    // The same samples read by their (zero) header stamps: refused, and the log says why and what to do.
+    let proc = slosh()
+        .args(["node", "--ros-args", "--params-file"])
+        .arg(&case)
+        .args(["-p", "input.stamp:=header"])
+        .env("ROS_DOMAIN_ID", "45")
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let seen = Instant::now();
+    while node.subscription_count("/motion/odom") == 0 {
+        assert!(
+            seen.elapsed() < Duration::from_secs(30),
+            "the node never subscribed"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    for _ in 0..20 {
+        let _ = odom.publish(rest_odometry(0.0));
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(Command::new("kill")
+        .args(["-TERM", &proc.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let out = proc.wait_with_output().unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        log.contains("the messages' header stamps are zero (never set?): stamp them, or set input.stamp: receive"),
+        "{log}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

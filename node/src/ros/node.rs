@@ -771,7 +771,12 @@ pub fn run(
                         log(
                             ros2_client::ros2::LogLevel::Warn,
                             &format!(
-                                "rejected a motion sample: {e} ({} rejected so far)",
+                                "rejected a motion sample: {e} (times since the first sample; its stamp is {ts:.6} s){} ({} rejected so far)",
+                                if c.input.stamp == StampSource::Header && ts == 0.0 {
+                                    ": the messages' header stamps are zero (never set?): stamp them, or set input.stamp: receive"
+                                } else {
+                                    ""
+                                },
                                 counters.rejected
                             ),
                         );
