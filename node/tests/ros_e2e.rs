@@ -973,6 +973,57 @@ fn accelerations_on_another_clock_than_the_motion_are_rejected_and_said() {
 }
 
 #[test]
+fn a_clock_on_another_time_base_than_the_motion_is_said() {
+    if !common::in_private_netns("a_clock_on_another_time_base_than_the_motion_is_said") {
+        return;
+    }
+    let dir = common::tmp("ros-clock-base");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case("    use_sim_time: true\n")).unwrap();
+    let (_ctx, mut node) = test_node(49, "e2e_clock_base");
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
+    let clock = publisher::<Clock>(&mut node, "/", "clock", &qos);
+    let proc = slosh()
+        .args(["node", "--ros-args", "--params-file"])
+        .arg(&case)
+        .env("ROS_DOMAIN_ID", "49")
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let seen = Instant::now();
+    while node.subscription_count("/motion/odom") == 0 || node.subscription_count("/clock") == 0 {
+        assert!(
+            seen.elapsed() < Duration::from_secs(30),
+            "the node never subscribed"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    // The motion stamped from 1000 s, the clock from 0 s: 6 s of both.
+    for k in 0..300 {
+        let t = k as f64 * 0.02;
+        let _ = odom.publish(rest_odometry(1000.0 + t));
+        let _ = clock.publish(Clock {
+            clock: Time::from_secs_f64(t),
+        });
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(Command::new("kill")
+        .args(["-TERM", &proc.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let out = proc.wait_with_output().unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        log.contains("behind the motion's stamps") && log.contains("must be on one time base"),
+        "{log}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_solver_failure_is_in_the_recording_with_its_diagnostics() {
     if !common::in_private_netns("a_solver_failure_is_in_the_recording_with_its_diagnostics") {
         return;

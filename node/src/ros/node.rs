@@ -635,6 +635,7 @@ pub fn run(
     // Warnings while no motion sample has come yet, and while follow_clock has motion but no /clock (first
     // after motion_timeout_s or 5 s).
     let (mut no_motion, mut no_clock) = (Reminder::default(), Reminder::default());
+    let mut clock_behind = Reminder::default();
     let first_reminder = c.motion_timeout_s.max(5.0);
     let mut holding = false;
     let mut tf_sent = false;
@@ -933,6 +934,20 @@ pub fn run(
                         counters.accepted
                     ),
                 );
+            }
+            // A /clock on another time base than the motion's stamps: the simulation waits for a ROS time
+            // that is far behind it.
+            if let Some(now) = ros_time {
+                let behind = sim.time() - (now - base);
+                if behind > c.input.max_gap_s && clock_behind.due(wall(), first_reminder) {
+                    log(
+                        ros2_client::ros2::LogLevel::Warn,
+                        &format!(
+                            "realtime.mode follow_clock: /clock reads {now:.3} s, {behind:.3} s behind the motion's stamps (the simulation is at stamp {:.3} s) and the simulation waits for it: /clock and the motion's header stamps must be on one time base (a bag played with --clock and its own stamps, or input.stamp: receive with a clock of the wall time)",
+                            base + sim.time()
+                        ),
+                    );
+                }
             }
         }
         let until = if paused {
