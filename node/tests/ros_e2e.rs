@@ -429,6 +429,48 @@ fn rest_odometry(t: f64) -> Odometry {
     }
 }
 
+/// `slosh node` on `case` (with `extra` ROS arguments) in DDS domain `domain`, its log captured, once `node`
+/// sees it subscribed to every one of `topics`.
+fn logged_node(
+    node: &ros2_client::Node,
+    case: &std::path::Path,
+    extra: &[&str],
+    domain: u16,
+    topics: &[&str],
+) -> Child {
+    let proc = slosh()
+        .args(["node", "--ros-args", "--params-file"])
+        .arg(case)
+        .args(extra)
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let seen = Instant::now();
+    while topics.iter().any(|t| node.subscription_count(t) == 0) {
+        assert!(
+            seen.elapsed() < Duration::from_secs(30),
+            "the node never subscribed"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    proc
+}
+
+/// Stops a [`logged_node`] with SIGTERM; its log, once it has exited cleanly.
+fn stop_logged(proc: Child) -> String {
+    assert!(Command::new("kill")
+        .args(["-TERM", &proc.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let out = proc.wait_with_output().unwrap();
+    let log = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{log}");
+    log
+}
+
 /// Calls a service until it answers (the first requests may go out before discovery has matched).
 fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(
     client: &ros2_client::Client<Req, Resp>,
@@ -816,22 +858,7 @@ fn receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping() {
     let (_ctx, mut node) = test_node(45, "e2e_receive");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
-    let proc = slosh()
-        .args(["node", "--ros-args", "--params-file"])
-        .arg(&case)
-        .env("ROS_DOMAIN_ID", "45")
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let seen = Instant::now();
-    while node.subscription_count("/motion/odom") == 0 {
-        assert!(
-            seen.elapsed() < Duration::from_secs(30),
-            "the node never subscribed"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(300));
+    let proc = logged_node(&node, &case, &[], 45, &["/motion/odom"]);
     // 2 s of samples at 50 Hz, all with the same header stamp: only their arrival times order them.
     let sent = 100;
     for _ in 0..sent {
@@ -839,15 +866,7 @@ fn receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping() {
         std::thread::sleep(Duration::from_millis(20));
     }
     std::thread::sleep(Duration::from_millis(1500));
-    let pid = proc.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
-    let out = proc.wait_with_output().unwrap();
-    let log = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{log}");
+    let log = stop_logged(proc);
     // Stamped when they were taken from the reader, not when a stretch of steps ended (then every sample
     // that came in during the stretch had the same stamp and all but the first were out of order).
     let counts = log
@@ -866,35 +885,19 @@ fn receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping() {
     assert!(rejected == 0 && accepted >= sent - 5, "{counts}\n{log}");
 
     // The same samples read by their (zero) header stamps: refused, and the log says why and what to do.
-    let proc = slosh()
-        .args(["node", "--ros-args", "--params-file"])
-        .arg(&case)
-        .args(["-p", "input.stamp:=header"])
-        .env("ROS_DOMAIN_ID", "45")
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let seen = Instant::now();
-    while node.subscription_count("/motion/odom") == 0 {
-        assert!(
-            seen.elapsed() < Duration::from_secs(30),
-            "the node never subscribed"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(300));
+    let proc = logged_node(
+        &node,
+        &case,
+        &["-p", "input.stamp:=header"],
+        45,
+        &["/motion/odom"],
+    );
     for _ in 0..20 {
         let _ = odom.publish(rest_odometry(0.0));
         std::thread::sleep(Duration::from_millis(20));
     }
     std::thread::sleep(Duration::from_millis(300));
-    assert!(Command::new("kill")
-        .args(["-TERM", &proc.id().to_string()])
-        .status()
-        .unwrap()
-        .success());
-    let out = proc.wait_with_output().unwrap();
-    let log = String::from_utf8_lossy(&out.stderr);
+    let log = stop_logged(proc);
     assert!(
         log.contains("the messages' header stamps are zero (never set?): stamp them, or set input.stamp: receive"),
         "{log}"
@@ -916,24 +919,7 @@ fn accelerations_on_another_clock_than_the_motion_are_rejected_and_said() {
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
     let accel = publisher::<AccelStamped>(&mut node, "/motion", "accel", &qos);
-    let proc = slosh()
-        .args(["node", "--ros-args", "--params-file"])
-        .arg(&case)
-        .env("ROS_DOMAIN_ID", "48")
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let seen = Instant::now();
-    while node.subscription_count("/motion/odom") == 0
-        || node.subscription_count("/motion/accel") == 0
-    {
-        assert!(
-            seen.elapsed() < Duration::from_secs(30),
-            "the node never subscribed"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(300));
+    let proc = logged_node(&node, &case, &[], 48, &["/motion/odom", "/motion/accel"]);
     // The motion stamped from 1000 s, its accelerations from 0 s (a second clock).
     for k in 0..60 {
         let t = k as f64 * 0.02;
@@ -955,15 +941,7 @@ fn accelerations_on_another_clock_than_the_motion_are_rejected_and_said() {
         std::thread::sleep(Duration::from_millis(20));
     }
     std::thread::sleep(Duration::from_millis(500));
-    let pid = proc.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
-    let out = proc.wait_with_output().unwrap();
-    let log = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{log}");
+    let log = stop_logged(proc);
     assert!(
         log.contains("rejected an acceleration sample: stamp 0.")
             && log.contains("AccelStamped must carry the motion's time stamps"),
@@ -984,22 +962,7 @@ fn a_clock_on_another_time_base_than_the_motion_is_said() {
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
     let clock = publisher::<Clock>(&mut node, "/", "clock", &qos);
-    let proc = slosh()
-        .args(["node", "--ros-args", "--params-file"])
-        .arg(&case)
-        .env("ROS_DOMAIN_ID", "49")
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let seen = Instant::now();
-    while node.subscription_count("/motion/odom") == 0 || node.subscription_count("/clock") == 0 {
-        assert!(
-            seen.elapsed() < Duration::from_secs(30),
-            "the node never subscribed"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(300));
+    let proc = logged_node(&node, &case, &[], 49, &["/motion/odom", "/clock"]);
     // The motion stamped from 1000 s, the clock from 0 s: 6 s of both.
     for k in 0..300 {
         let t = k as f64 * 0.02;
@@ -1009,13 +972,7 @@ fn a_clock_on_another_time_base_than_the_motion_is_said() {
         });
         std::thread::sleep(Duration::from_millis(20));
     }
-    assert!(Command::new("kill")
-        .args(["-TERM", &proc.id().to_string()])
-        .status()
-        .unwrap()
-        .success());
-    let out = proc.wait_with_output().unwrap();
-    let log = String::from_utf8_lossy(&out.stderr);
+    let log = stop_logged(proc);
     assert!(
         log.contains("behind the motion's stamps") && log.contains("must be on one time base"),
         "{log}"
