@@ -39,6 +39,22 @@ pub struct Limits {
     pub max_rotation_rate: f64,
 }
 
+impl Limits {
+    /// Refuses a move of `size` (m or rad) in `dt` s faster than `limit` (`max_speed` or
+    /// `max_rotation_rate`) as a jump of `what`.
+    pub fn jump(what: &'static str, size: f64, dt: f64, limit: f64) -> Result<(), Rejected> {
+        if size > limit * dt {
+            return Err(Rejected::Jump {
+                what,
+                size,
+                dt,
+                limit,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Tank poses received so far (times relative to the first sample), as a [`TankMotion`].
 #[derive(Debug)]
 pub struct LiveMotion {
@@ -148,25 +164,11 @@ pub fn check_pose(
     let dt = t - t0;
     let dist =
         ((pose[0] - p0[0]).powi(2) + (pose[1] - p0[1]).powi(2) + (pose[2] - p0[2]).powi(2)).sqrt();
-    if dist > limits.max_speed * dt {
-        return Err(Rejected::Jump {
-            what: "position (m)",
-            size: dist,
-            dt,
-            limit: limits.max_speed,
-        });
-    }
+    Limits::jump("position (m)", dist, dt, limits.max_speed)?;
     for k in 3..6 {
         let d = pose[k] - p0[k];
         let d = (d - (d / (2.0 * PI)).round() * 2.0 * PI).abs();
-        if d > limits.max_rotation_rate * dt {
-            return Err(Rejected::Jump {
-                what: NAMES[k],
-                size: d,
-                dt,
-                limit: limits.max_rotation_rate,
-            });
-        }
+        Limits::jump(NAMES[k], d, dt, limits.max_rotation_rate)?;
     }
     Ok(())
 }

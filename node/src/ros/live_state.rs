@@ -21,23 +21,9 @@ pub fn check_jump(
     to: &RigidState,
 ) -> Result<(), Rejected> {
     let moved = (to.position - from.position).norm();
-    if moved > limits.max_speed * dt {
-        return Err(Rejected::Jump {
-            what: "position",
-            size: moved,
-            dt,
-            limit: limits.max_speed,
-        });
-    }
+    Limits::jump("position", moved, dt, limits.max_speed)?;
     let turned = from.orientation.angle_to(&to.orientation);
-    if turned > limits.max_rotation_rate * dt {
-        return Err(Rejected::Jump {
-            what: "orientation",
-            size: turned,
-            dt,
-            limit: limits.max_rotation_rate,
-        });
-    }
+    Limits::jump("orientation", turned, dt, limits.max_rotation_rate)?;
     Ok(())
 }
 
