@@ -1060,6 +1060,16 @@ impl Loaded {
                 "must be 1 (every particle) or more (every n-th), got 0",
             ));
         }
+        if c.record.chunk_size < 4096 {
+            return Err(key_err(
+                src,
+                "record.chunk_size",
+                format!(
+                    "must be at least 4096 bytes (the MCAP writer's smallest chunk; default 786432), got {}",
+                    c.record.chunk_size
+                ),
+            ));
+        }
         for (key, name) in [
             ("frames.tank", &c.frames.tank),
             ("frames.vessel", &c.frames.vessel),
@@ -1229,6 +1239,9 @@ mod tests {
             err(MIN, &["input.max_rotation_rate=0"]).contains("input.max_rotation_rate: must be")
         );
         assert!(err(MIN, &["particles.decimation=0"]).contains("particles.decimation: must be 1"));
+        assert!(
+            err(MIN, &["record.chunk_size=0"]).contains("record.chunk_size: must be at least 4096")
+        );
         assert!(err(MIN, &["frames.tank=''"])
             .contains("frames.tank: the frame's name may not be empty"));
         assert!(err(MIN, &["record.compression=lz4"])

@@ -458,6 +458,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 for d in &f.dropped {
                     eprintln!("slosh: dropped {d}");
                 }
+                if f.input_check.starts_with("input check") {
+                    eprintln!("slosh: warning: {}", f.input_check);
+                }
             }).map_err(Into::into))?;
             println!(
                 "done: {} s replayed in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s)",

@@ -122,6 +122,31 @@ pub struct Recorder {
     start_ns: Option<u64>,
     end_ns: u64,
     sequence: u32,
+    /// Added to every log time given (see [`Recorder::shift_log_times`]).
+    shift_ns: i64,
+}
+
+/// A message serialized for the recording, to be written once its log time is known.
+#[derive(Debug, Clone)]
+pub struct RawMessage {
+    pub topic: String,
+    /// `pkg/msg/Type`.
+    pub type_name: String,
+    /// Its `ros2msg` schema text.
+    pub schema: String,
+    /// CDR, with the encapsulation header.
+    pub data: Vec<u8>,
+}
+
+impl RawMessage {
+    pub fn of<M: RosMessage>(topic: &str, msg: &M) -> Self {
+        Self {
+            topic: topic.to_string(),
+            type_name: format!("{}/msg/{}", M::PACKAGE, M::NAME),
+            schema: M::ros2msg_schema(),
+            data: slosh_msgs::to_cdr(msg),
+        }
+    }
 }
 
 impl Recorder {
@@ -160,7 +185,7 @@ impl Recorder {
             .profile("ros2")
             .library(concat!("slosh ", env!("CARGO_PKG_VERSION")))
             .compression(compression)
-            .chunk_size(Some(cfg.chunk_size.max(4096)))
+            .chunk_size(Some(cfg.chunk_size))
             .create(BufWriter::new(file))
             .map_err(|e| err(format!("cannot start the MCAP file: {}", with_causes(&e))))?;
         let mut meta = BTreeMap::new();
@@ -179,6 +204,7 @@ impl Recorder {
             start_ns: None,
             end_ns: 0,
             sequence: 0,
+            shift_ns: 0,
         })
     }
 
@@ -186,17 +212,42 @@ impl Recorder {
         write_error(&self.dir, e)
     }
 
-    /// Records `msg` on `topic` at `log_time` (ROS time; negative times are written as 0).
+    /// Records `msg` on `topic` at `log_time` (ROS time, shifted as [`Recorder::shift_log_times`] says;
+    /// negative times are written as 0).
     pub fn write<M: RosMessage>(
         &mut self,
         topic: &str,
         log_time: Time,
         msg: &M,
     ) -> Result<(), RecordError> {
-        let ns = log_time.as_nanos().max(0) as u64;
-        let schema = format!("{}/msg/{}", M::PACKAGE, M::NAME);
-        let data = slosh_msgs::to_cdr(msg);
-        self.write_raw(topic, &schema, &M::ros2msg_schema(), ns, &data)
+        let raw = RawMessage::of(topic, msg);
+        self.write_message(&raw, log_time)
+    }
+
+    /// Records a serialized message at `log_time` (shifted as [`Recorder::shift_log_times`] says).
+    pub fn write_message(&mut self, m: &RawMessage, log_time: Time) -> Result<(), RecordError> {
+        let ns = log_time.as_nanos().saturating_add(self.shift_ns).max(0) as u64;
+        self.write_raw(&m.topic, &m.type_name, &m.schema, ns, &m.data)
+    }
+
+    /// Records a serialized message at the latest log time written so far (`log_time`, shifted, when nothing
+    /// has been written yet): for input the node refused, whose own stamp (an hour ahead, or on another time
+    /// base) would put it out of the recording's order and stretch its duration.
+    pub fn write_message_now(&mut self, m: &RawMessage, log_time: Time) -> Result<(), RecordError> {
+        if self.start_ns.is_none() {
+            return self.write_message(m, log_time);
+        }
+        self.write_raw(&m.topic, &m.type_name, &m.schema, self.end_ns, &m.data)
+    }
+
+    /// From now on every log time given is shifted so that `log_time` comes right after the latest log time
+    /// written so far: a node whose input restarted on an earlier time base (whose outputs' stamps follow it
+    /// back) keeps its recording's log times going forward, so players and `slosh replay` read the
+    /// recording in the order it happened. The messages' header stamps are left as they are.
+    pub fn continue_from(&mut self, log_time: Time) {
+        if self.start_ns.is_some() {
+            self.shift_ns = (self.end_ns as i64 + 1).saturating_sub(log_time.as_nanos());
+        }
     }
 
     /// Records an already serialized CDR message (with its encapsulation header) of ROS type `type_name`

@@ -670,7 +670,8 @@ fn the_node_rejects_a_stamp_from_the_future_and_follows_a_restarted_clock() {
                 "-p",
                 "iceoryx2.service:=tank2",
             ])
-            .args(["-p", "realtime.mode:=lockstep"])
+            .args(["-p", "realtime.mode:=lockstep", "-p"])
+            .arg(format!("record.path:={}", dir.join("bag").display()))
             .env("ROS_DOMAIN_ID", "62")
             .stderr(Stdio::piped())
             .spawn()
@@ -729,6 +730,101 @@ fn the_node_rejects_a_stamp_from_the_future_and_follows_a_restarted_clock() {
             && err.contains("10 samples in a row follow the new stamps"),
         "{err}"
     );
+    // The recording goes on forward through both: the refused sample an hour ahead is recorded once, at
+    // the log time it came in, and the samples and outputs on the restarted clock follow the earlier ones
+    // (players and `slosh replay` read a bag in log-time order), read by rosbags and by mcap.
+    let b = common::read_bag(&dir.join("bag"));
+    for reader in ["rosbags", "mcap"] {
+        let items = |t: &str| b[reader][t]["items"].as_array().unwrap().clone();
+        let stamps: Vec<f64> = items("/motion/odom")
+            .iter()
+            .map(|i| i[1][13].as_f64().unwrap())
+            .collect();
+        let ahead = stamps.iter().filter(|s| **s > 4000.0).count();
+        let first: Vec<f64> = stamps.iter().copied().filter(|s| *s < 2000.0).collect();
+        let split = first.iter().position(|s| *s < 500.0).unwrap_or(first.len());
+        assert!(
+            ahead == 1 && split >= 40 && first.len() > split + 5,
+            "{reader}: {stamps:?}"
+        );
+        assert!(
+            first[..split]
+                .windows(2)
+                .all(|w| w[1] > w[0] && w[0] > 999.0)
+                && first[split..]
+                    .windows(2)
+                    .all(|w| w[1] > w[0] && w[1] < 100.0),
+            "{reader}: the motion in log-time order: {stamps:?}"
+        );
+        let log_times =
+            |t: &str| -> Vec<f64> { items(t).iter().map(|i| i[0].as_f64().unwrap()).collect() };
+        let all: Vec<f64> = ["/motion/odom", "/motion/accel", "/wrench", "/probes"]
+            .iter()
+            .flat_map(|t| log_times(t))
+            .collect();
+        let span = all.iter().cloned().fold(f64::MIN, f64::max)
+            - all.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(span < 3.0, "{reader}: the recording spans {span} s");
+        let wrench = log_times("/wrench");
+        assert!(
+            wrench.len() >= 15
+                && wrench
+                    .windows(2)
+                    .all(|w| w[1] - w[0] > 0.0 && w[1] - w[0] < 0.2),
+            "{reader}: wrench log times {wrench:?}"
+        );
+    }
+    // Replayed on its header stamps the bag stops at the restart, saying how to replay it on its log times;
+    // on them it replays whole, the refused sample (recorded at the log time it came in) dropped.
+    let replay = |name: &str, extra: &[&str]| {
+        slosh()
+            .arg("replay")
+            .arg(dir.join("bag"))
+            .arg("--config")
+            .arg(&case)
+            .arg("--out")
+            .arg(dir.join(name))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = replay("on_header", &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("more than input.max_gap_s = 5"),
+        "{err}"
+    );
+    let o = replay("on_header_drop", &["--set", "replay.bad_samples=drop"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("on_header_drop/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let dropped = s["input"]["dropped"].as_array().unwrap();
+    assert!(
+        dropped.iter().any(|d| d
+            .as_str()
+            .unwrap()
+            .contains("the header stamps go back by 950.")
+            && d.as_str().unwrap().contains("--set input.stamp=receive")),
+        "{s}"
+    );
+    let o = replay(
+        "on_log",
+        &[
+            "--set",
+            "input.stamp=receive",
+            "--set",
+            "replay.bad_samples=drop",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("on_log/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s["input"]["time_source"], "log", "{s}");
+    assert_eq!(s["input"]["dropped"].as_array().unwrap().len(), 1, "{s}");
+    assert!(s["input"]["span_s"].as_f64().unwrap() > 1.0, "{s}");
     drop(publisher);
     drop(svc);
     drop(publisher_node);

@@ -182,6 +182,7 @@ fn an_imu_bag_replays_close_to_run_from_the_same_motion() {
     let (ok, err) = replay(&bag, &case, &out, &["--duration", "1.4"]);
     assert!(ok, "{err}");
     assert_eq!(summary(&out)["input"]["type"], "sensor_msgs/msg/Imu");
+    assert_eq!(summary(&out)["input"]["input_check"], "ok");
     let (w, run_w) = (
         csv(&out.join("wrench.csv")).1,
         csv(&dir.join("run/wrench.csv")).1,
@@ -207,6 +208,25 @@ fn an_imu_bag_replays_close_to_run_from_the_same_motion() {
         .flat_map(|(a, b)| a[1..].iter().zip(&b[1..]).map(|(x, y)| (x - y).abs()))
         .fold(0.0, f64::max);
     assert!(worst < 0.006, "probes differ by up to {worst} m");
+
+    // The same motion as poses read as if their world were NED: the tank is upside down, and the replay
+    // says so.
+    let odom = write_bag(&dir, "odom_bag", &["--type", "odom"]);
+    let flipped = dir.join("flipped");
+    let (ok, err) = replay(
+        &odom,
+        &case,
+        &flipped,
+        &["--duration", "0.6", "--set", "input.world_frame=ned"],
+    );
+    assert!(ok, "{err}");
+    let check = summary(&flipped)["input"]["input_check"].clone();
+    assert!(
+        check.as_str().unwrap().contains("pointing up")
+            && err.contains("slosh: warning: input check")
+            && err.contains("input.world_frame and input.body_frame"),
+        "{check}\n{err}"
+    );
 }
 
 #[test]

@@ -10,7 +10,7 @@ use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
 };
 use slosh_msgs::builtin_interfaces::Time;
-use slosh_msgs::diagnostic_msgs::DiagnosticArray;
+use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus};
 use slosh_msgs::geometry_msgs::{Accel, AccelStamped, Vector3, WrenchStamped};
 use slosh_msgs::geometry_msgs::{Pose, PoseWithCovariance, Quaternion, TwistWithCovariance};
 use slosh_msgs::nav_msgs::Odometry;
@@ -946,6 +946,112 @@ fn accelerations_on_another_clock_than_the_motion_are_rejected_and_said() {
         log.contains("rejected an acceleration sample: stamp 0.")
             && log.contains("AccelStamped must carry the motion's time stamps"),
         "{log}"
+    );
+    // An upright tank at rest passes the frame conventions' check.
+    assert!(!log.contains("input check"), "{log}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn lockstep_motion_ends_when_the_node_it_follows_has_exited() {
+    if !common::in_private_netns("lockstep_motion_ends_when_the_node_it_follows_has_exited") {
+        return;
+    }
+    let dir = common::tmp("ros-lockstep-end");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case("")).unwrap();
+    let node_proc = Kill(
+        slosh()
+            .args(["node", "--duration", "0.5", "--ros-args", "--params-file"])
+            .arg(&case)
+            .args(["-p", "realtime.mode:=lockstep"])
+            .env("ROS_DOMAIN_ID", "51")
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    // A minute of motion in lockstep with a node that stops after half a second.
+    let mut motion = Kill(
+        slosh()
+            .arg("motion")
+            .arg(&case)
+            .args(["--rate", "50", "--duration", "60", "--lockstep"])
+            .args(["--wait-for-subscribers", "1"])
+            .env("ROS_DOMAIN_ID", "51")
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let start = Instant::now();
+    let status = loop {
+        if let Some(st) = motion.0.try_wait().unwrap() {
+            break st;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "slosh motion --lockstep still runs a minute after its node stopped"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let mut log = String::new();
+    std::io::Read::read_to_string(&mut motion.0.stderr.take().unwrap(), &mut log).unwrap();
+    assert!(
+        status.success() && log.contains("/motion/odom has no subscriber any more"),
+        "{status}: {log}"
+    );
+    drop(node_proc);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn poses_read_in_the_wrong_frame_convention_are_said() {
+    if !common::in_private_netns("poses_read_in_the_wrong_frame_convention_are_said") {
+        return;
+    }
+    let dir = common::tmp("ros-frame-check");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case("")).unwrap();
+    let (_ctx, mut node) = test_node(50, "e2e_frame_check");
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
+    let diag = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
+    // An upright vessel at rest (ENU world, FLU body) read as if its world were NED: the tank is upside down.
+    let proc = logged_node(
+        &node,
+        &case,
+        &[
+            "-p",
+            "input.world_frame:=ned",
+            "-p",
+            "diagnostics_rate_hz:=10.0",
+        ],
+        50,
+        &["/motion/odom"],
+    );
+    let mut levels = Vec::new();
+    for k in 0..75 {
+        let _ = odom.publish(rest_odometry(1000.0 + k as f64 * 0.02));
+        std::thread::sleep(Duration::from_millis(20));
+        while let Ok(Some((d, _))) = diag.take() {
+            let st = &d.status[0];
+            let check = st.values.iter().find(|v| v.key == "input_check").unwrap();
+            levels.push((st.level, check.value.clone()));
+        }
+    }
+    let log = stop_logged(proc);
+    assert!(
+        log.contains(
+            "input check: over the first 0.5 s the apparent gravity in the tank frame averages ("
+        ) && log.contains("pointing up (the tank is upside down for the solver)")
+            && log.contains("input.world_frame and input.body_frame"),
+        "{log}"
+    );
+    // Diagnostics carry it, at WARN, once decided.
+    assert!(
+        levels
+            .iter()
+            .any(|(l, v)| *l == DiagnosticStatus::WARN && v.contains("pointing up")),
+        "{levels:?}"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

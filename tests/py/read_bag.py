@@ -38,7 +38,8 @@ def summarize(topic, msg):
     if hasattr(msg, "pose") and hasattr(msg, "twist"):
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         v, w = msg.twist.twist.linear, msg.twist.twist.angular
-        return [p.x, p.y, p.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z]
+        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        return [p.x, p.y, p.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z, stamp]
     return None
 
 

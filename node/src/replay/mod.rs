@@ -9,6 +9,7 @@ use crate::config::Loaded;
 use crate::output::Summary;
 use crate::record::{output_topics, RecordCfg, Recorder};
 use crate::ros::frames::Frames;
+use crate::ros::gravity_check::{GravityCheck, InputKind};
 use crate::ros::live_motion::Limits;
 use crate::runner::{drive, Drive, RecordState, RunError, RunOptions};
 use bag::BagError;
@@ -75,6 +76,9 @@ pub struct Found {
     pub span_s: f64,
     /// The new recording.
     pub recording: String,
+    /// The frame conventions' plausibility check over the first half second (see
+    /// [`crate::ros::gravity_check`]): `ok` or its warning.
+    pub input_check: String,
 }
 
 /// Replays `bag` through the case `cfg` into `out`; `announce` is told what motion was found before the
@@ -98,6 +102,7 @@ pub fn replay(
             max_speed: c.input.max_speed,
             max_rotation_rate: c.input.max_rotation_rate,
         },
+        max_gap_s: c.input.max_gap_s,
         frames: &frames,
         gravity: params.gravity,
     };
@@ -112,6 +117,22 @@ pub fn replay(
         c.record.clone()
     };
     let span = bm.motion.end_time();
+    let kind = match bm.kind {
+        motion::Kind::Imu => InputKind::Imu,
+        _ => InputKind::Pose,
+    };
+    let mut check = GravityCheck::default();
+    let input_check = (0..)
+        .map(|k| k as f64 * 0.01)
+        .take_while(|t| *t <= span)
+        .find_map(|t| {
+            let g = bm.motion.state(t).apparent_gravity(params.gravity);
+            check.add(t, g, params.gravity, kind)
+        })
+        .map_or_else(
+            || "too short to check".to_string(),
+            |r| r.err().unwrap_or_else(|| "ok".into()),
+        );
     let found = Found {
         bag: bag_path.display().to_string(),
         topic: bm.topic.clone(),
@@ -123,6 +144,7 @@ pub fn replay(
         start_stamp_s: Time::from_nanos(bm.t0_ns).as_secs_f64(),
         span_s: span,
         recording: record_cfg.path.clone(),
+        input_check,
     };
     announce(&found);
     let tank_frame = c.frames.tank.clone();

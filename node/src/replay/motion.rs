@@ -63,6 +63,8 @@ pub struct Reading<'a> {
     pub stamp: StampSource,
     pub bad_samples: BadSamples,
     pub limits: Limits,
+    /// `input.max_gap_s`: a sample stamped more than this after the newest accepted one is refused.
+    pub max_gap_s: f64,
     pub frames: &'a Frames,
     pub gravity: f64,
 }
@@ -341,6 +343,16 @@ fn build(
     let mut messages = Vec::new();
     let mut reject = |i: usize, r: Rejected| -> Result<(), String> {
         let what = format!("topic {topic}, message {}: {r}", i + 1);
+        // Header stamps that go back by seconds: the publisher restarted on another time base while it was
+        // recorded. The log times of a bag recorded by `slosh node` (or `ros2 bag record`) go on in order.
+        let restarted = match r {
+            Rejected::OutOfOrder { time, newest } if header && newest - time > 1.0 => format!(
+                " (the header stamps go back by {:.3} s: a publisher restarted on another time base? the bag's log times stay in order: replay on them with `--set input.stamp=receive`)",
+                newest - time
+            ),
+            _ => String::new(),
+        };
+        let what = what + &restarted;
         match how.bad_samples {
             BadSamples::Error => Err(format!(
                 "{what}; replay.bad_samples is `error` (set `--set replay.bad_samples=drop` to skip such samples)"
@@ -358,8 +370,20 @@ fn build(
         how.frames.mount().0,
         how.frames.mount().1,
     );
+    let mut newest: Option<f64> = None;
     for (i, d) in decoded.iter().enumerate() {
         let t = (time_ns(d) - t0_ns) as f64 * 1e-9;
+        // As the node: a stamp far ahead (garbled, a clock set wrong) would make the whole gap one move.
+        if let Some(gap) = newest.map(|n| t - n).filter(|g| *g > how.max_gap_s) {
+            reject(
+                i,
+                Rejected::Invalid(format!(
+                    "stamp {t:.6} s is {gap:.3} s after the newest sample's, more than input.max_gap_s = {}",
+                    how.max_gap_s
+                )),
+            )?;
+            continue;
+        }
         let accepted = match &d.reading {
             R::Pose(p) => tank_coordinates(p, how.frames).and_then(|c| {
                 let prev = times.last().copied().zip(poses.last().copied());
@@ -372,7 +396,10 @@ fn build(
             R::State(_) => unreachable!("bags are decoded to poses or IMU readings"),
         };
         match accepted {
-            Ok(()) => messages.push((time_ns(d), f.messages[i].1.clone())),
+            Ok(()) => {
+                newest = Some(t);
+                messages.push((time_ns(d), f.messages[i].1.clone()))
+            }
             Err(r) => reject(i, r)?,
         }
     }

@@ -245,10 +245,14 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
             ""
         }
     );
+    // Lockstep: whether the simulation has been seen subscribed (once it has gone, nothing will move /clock).
+    let mut subscribed = false;
     for k in 0..=n {
         let t = k as f64 / opts.rate_hz;
         if let Some(sub) = &clock {
             // Stay `lead` samples ahead of the simulation.
+            let waiting = Instant::now();
+            let (mut checked, mut reminded) = (waiting, waiting);
             while k >= lead && clock_t < t - lead as f64 / opts.rate_hz - 1e-9 {
                 if stop.load(Ordering::Relaxed) {
                     return Ok(());
@@ -256,6 +260,26 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
                 match sub.take() {
                     Ok(Some((c, _))) => clock_t = c.clock.as_secs_f64() - start_stamp,
                     _ => std::thread::sleep(Duration::from_millis(1)),
+                }
+                if checked.elapsed() > Duration::from_millis(100) {
+                    checked = Instant::now();
+                    let count = node.subscription_count(&odom_topic);
+                    subscribed |= count > 0;
+                    if subscribed && count == 0 {
+                        eprintln!(
+                            "slosh motion: {odom_topic} has no subscriber any more (the simulation ended?): stopping at t = {t:.3} s after {k} of {} samples",
+                            n + 1
+                        );
+                        return Ok(());
+                    }
+                    if reminded.elapsed() > Duration::from_secs(10) {
+                        reminded = Instant::now();
+                        eprintln!(
+                            "slosh motion: --lockstep: waiting for /clock to pass t = {:.3} s (it reads {}): is the simulation running, in realtime.mode lockstep, on this ROS_DOMAIN_ID?",
+                            t - lead as f64 / opts.rate_hz,
+                            if clock_t.is_finite() { format!("{clock_t:.3} s") } else { "nothing yet".into() }
+                        );
+                    }
                 }
             }
         } else {

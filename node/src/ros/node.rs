@@ -5,12 +5,13 @@
 use super::args::{Names, RosArgs};
 use super::convert::{quat_msg, vec3_msg};
 use super::frames::Frames;
+use super::gravity_check::{GravityCheck, InputKind};
 use super::live::{Live, Reading};
 use super::live_motion::Limits;
 use super::pacing::Pacing;
 use super::publish;
 use crate::config::{InputType, Loaded, RealtimeMode, StampSource};
-use crate::record::Recorder;
+use crate::record::{RawMessage, Recorder};
 use nalgebra::UnitQuaternion;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile, ServiceMapping, ServiceTypeName};
@@ -26,6 +27,7 @@ use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
 use slosh_msgs::std_msgs::Header;
 use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
 use slosh_msgs::tf2_msgs::TFMessage;
+use sph::motion::TankMotion as _;
 use sph::params::SimParams;
 use std::collections::VecDeque;
 use std::sync::atomic::Ordering;
@@ -243,6 +245,8 @@ struct Counters {
     timeouts: u64,
     /// How the particle spacing was chosen (`realtime.auto_resolution`).
     resolution: String,
+    /// The frame conventions' plausibility check: empty until it has decided, `ok`, or its warning.
+    input_check: String,
 }
 
 enum Input {
@@ -274,38 +278,27 @@ impl Input {
         }
     }
 
-    /// The next received sample: (header stamp, reading); recorded as received when `rec` is given.
-    fn take(&self, rec: Option<(&mut Recorder, &str)>) -> anyhow::Result<Option<(Time, Reading)>> {
+    /// The next received sample: (header stamp, reading, the messages to record, serialized for the topic
+    /// `rec` when given). The node records them once it has taken or refused the sample.
+    fn take(&self, rec: Option<&str>) -> anyhow::Result<Option<Taken>> {
         let err = |what: &str, e: ros2_client::ReadError| anyhow::anyhow!("reading {what}: {e:?}");
-        fn keep<M: slosh_msgs::RosMessage>(
-            rec: Option<(&mut Recorder, &str)>,
-            stamp: Time,
-            m: &M,
-        ) -> anyhow::Result<()> {
-            if let Some((r, topic)) = rec {
-                r.write(topic, stamp, m)?;
-            }
-            Ok(())
+        fn keep<M: slosh_msgs::RosMessage>(rec: Option<&str>, m: &M) -> Vec<RawMessage> {
+            rec.map(|topic| vec![RawMessage::of(topic, m)])
+                .unwrap_or_default()
         }
         Ok(match self {
             Input::Odom(s) => match s.take().map_err(|e| err("motion/odom", e))? {
-                Some((m, _)) => {
-                    keep(rec, m.header.stamp, &m)?;
-                    Some((m.header.stamp, Reading::Pose(m.pose.pose)))
-                }
+                Some((m, _)) => Some((m.header.stamp, keep(rec, &m), Reading::Pose(m.pose.pose))),
                 None => None,
             },
             Input::Pose(s) => match s.take().map_err(|e| err("motion/pose", e))? {
-                Some((m, _)) => {
-                    keep(rec, m.header.stamp, &m)?;
-                    Some((m.header.stamp, Reading::Pose(m.pose)))
-                }
+                Some((m, _)) => Some((m.header.stamp, keep(rec, &m), Reading::Pose(m.pose))),
                 None => None,
             },
             Input::Imu(s) => match s.take().map_err(|e| err("motion/imu", e))? {
                 Some((m, _)) => {
-                    keep(rec, m.header.stamp, &m)?;
-                    Some((m.header.stamp, Reading::Imu(Box::new(m))))
+                    let raw = keep(rec, &m);
+                    Some((m.header.stamp, raw, Reading::Imu(Box::new(m))))
                 }
                 None => None,
             },
@@ -316,28 +309,53 @@ impl Input {
                 Some(sample) => {
                     let m: crate::iox::MotionSample = *sample.payload();
                     let stamp = Time::from_secs_f64(m.time);
-                    if let Some((r, topic)) = rec {
+                    let mut raw = Vec::new();
+                    if let Some(topic) = rec {
                         let identity = crate::iox::Mount {
                             offset: Default::default(),
                             rotation: UnitQuaternion::identity(),
                         };
                         let v = crate::iox::tank_state(&m, &identity);
-                        r.write(
+                        raw.push(RawMessage::of(
                             topic,
-                            stamp,
                             &super::motion_pub::odometry(&v, stamp, "odom", vessel),
-                        )?;
-                        r.write(
+                        ));
+                        raw.push(RawMessage::of(
                             accel_topic,
-                            stamp,
                             &super::motion_pub::accel(&v, stamp, vessel),
-                        )?;
+                        ));
                     }
-                    Some((stamp, Reading::State(m)))
+                    Some((stamp, raw, Reading::State(m)))
                 }
                 None => None,
             },
         })
+    }
+}
+
+/// A received sample: its header stamp, its messages for the recording, the reading.
+type Taken = (Time, Vec<RawMessage>, Reading);
+
+/// A sample the input loop decides on.
+struct Sample {
+    /// Its time on the input's time base (s): the header stamp, or when it was taken (`input.stamp`).
+    ts: f64,
+    /// The same, as the log time it is recorded at once taken.
+    log: Time,
+    reading: Reading,
+    /// When it was taken from the reader (the node's wall clock, s).
+    received: f64,
+    /// Its messages for the recording (none when not recording).
+    raw: Vec<RawMessage>,
+}
+
+impl Sample {
+    /// Records a refused sample at the recording's latest log time.
+    fn record_refused(&self, r: &mut Recorder) -> Result<(), crate::record::RecordError> {
+        for m in &self.raw {
+            r.write_message_now(m, self.log)?;
+        }
+        Ok(())
     }
 }
 
@@ -631,7 +649,7 @@ pub fn run(
     // The stamp (s) of the newest accepted motion sample, and the samples rejected in a row since that look
     // like a motion on another time base.
     let mut newest_stamp: Option<f64> = None;
-    let mut other_base: Vec<(f64, Reading, f64)> = Vec::new();
+    let mut other_base: Vec<Sample> = Vec::new();
     // Warnings while no motion sample has come yet, and while follow_clock has motion but no /clock (first
     // after motion_timeout_s or 5 s).
     let (mut no_motion, mut no_clock) = (Reminder::default(), Reminder::default());
@@ -639,11 +657,19 @@ pub fn run(
     let first_reminder = c.motion_timeout_s.max(5.0);
     let mut holding = false;
     let mut tf_sent = false;
+    let mut gravity_check = GravityCheck::default();
+    let mut last_clock: Option<Time> = None;
+    let input_kind = match c.input.kind {
+        InputType::Odom | InputType::Pose => InputKind::Pose,
+        InputType::Imu => InputKind::Imu,
+        InputType::Iceoryx2 => InputKind::State,
+    };
     let dt_cap = params.solver.dt_max;
     let mut error: Option<String> = None;
     // Samples taken from the reader (also between steps), with when they were taken: the node's wall clock
     // (for the input's age) and the Unix time (the stamp of `input.stamp: receive`).
-    let mut pending: Vec<(Time, Reading, f64, f64)> = Vec::with_capacity(64);
+    let mut pending: Vec<(Taken, f64, f64)> = Vec::with_capacity(64);
+    let rec_topic = recorder.is_some().then(|| in_topic.clone());
     let unix_now = || {
         std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
@@ -713,26 +739,38 @@ pub fn run(
         }
         // 1. Drain the input (and what was fetched while stepping).
         let mut got = false;
-        while let Some((stamp, reading)) =
-            input.take(recorder.as_mut().map(|r| (r, in_topic.as_str())))?
-        {
-            pending.push((stamp, reading, wall(), unix_now()));
+        while let Some(taken) = input.take(rec_topic.as_deref())? {
+            pending.push((taken, wall(), unix_now()));
         }
-        let mut incoming: VecDeque<(f64, Reading, f64)> = pending
+        let mut incoming: VecDeque<Sample> = pending
             .drain(..)
-            .map(|(stamp, reading, w, unix)| {
-                let ts = match c.input.stamp {
-                    StampSource::Header => stamp.as_secs_f64(),
-                    StampSource::Receive => unix,
+            .map(|((stamp, raw, reading), received, unix)| {
+                let log = match c.input.stamp {
+                    StampSource::Header => stamp,
+                    StampSource::Receive => Time::from_secs_f64(unix),
                 };
-                (ts, reading, w)
+                Sample {
+                    ts: log.as_secs_f64(),
+                    log,
+                    reading,
+                    received,
+                    raw,
+                }
             })
             .collect();
-        while let Some((ts, reading, received)) = incoming.pop_front() {
+        while let Some(sample) = incoming.pop_front() {
+            let ts = sample.ts;
             let w = wall();
             if rebase {
                 rebase = false;
-                t0 = Some(ts - sim.time());
+                let new_t0 = ts - sim.time();
+                // Input on an earlier time base: the recording's log times go on from where they were.
+                if let (Some(old), Some(r)) = (t0, recorder.as_mut()) {
+                    if new_t0 < old {
+                        r.continue_from(sample.log);
+                    }
+                }
+                t0 = Some(new_t0);
             }
             let base = *t0.get_or_insert(ts);
             // A stamp far ahead of the newest sample (a garbled stamp, a clock set wrong) is rejected: the
@@ -748,16 +786,25 @@ pub fn run(
                     c.input.max_gap_s
                 )),
                 None => motion
-                    .push(ts - base, &reading, &frames)
+                    .push(ts - base, &sample.reading, &frames)
                     .map_err(|e| e.to_string()),
             };
             match pushed {
                 Ok(()) => {
+                    if let Some(r) = recorder.as_mut() {
+                        for m in &sample.raw {
+                            r.write_message(m, sample.log)?;
+                        }
+                        // Samples that looked like another time base, and were not.
+                        for s in other_base.drain(..) {
+                            s.record_refused(r)?;
+                        }
+                    }
                     newest_stamp = Some(ts);
                     other_base.clear();
                     last_real = ts - base;
                     counters.accepted += 1;
-                    pacing.input(received);
+                    pacing.input(sample.received);
                     got = true;
                     if holding {
                         holding = false;
@@ -788,16 +835,25 @@ pub fn run(
                     let off = gap.is_some() || newest_stamp.is_some_and(|n| ts <= n);
                     let follows = other_base
                         .last()
-                        .is_none_or(|(p, _, _)| ts > *p && ts - p <= c.input.max_gap_s);
-                    if !off {
-                        other_base.clear();
-                    } else {
-                        if !follows {
-                            other_base.clear();
+                        .is_none_or(|p| ts > p.ts && ts - p.ts <= c.input.max_gap_s);
+                    // Refused samples are recorded once refused for good, at the recording's latest log
+                    // time (their own stamps may lie an hour ahead or on another time base).
+                    if !off || !follows {
+                        if let Some(r) = recorder.as_mut() {
+                            for s in other_base.drain(..) {
+                                s.record_refused(r)?;
+                            }
                         }
-                        other_base.push((ts, reading, received));
+                        other_base.clear();
+                    }
+                    if !off {
+                        if let Some(r) = recorder.as_mut() {
+                            sample.record_refused(r)?;
+                        }
+                    } else {
+                        other_base.push(sample);
                         if other_base.len() >= NEW_TIME_BASE {
-                            let jump = other_base[0].0 - newest_stamp.unwrap_or(other_base[0].0);
+                            let jump = other_base[0].ts - newest_stamp.unwrap_or(other_base[0].ts);
                             log(
                                 ros2_client::ros2::LogLevel::Warn,
                                 &format!(
@@ -977,12 +1033,19 @@ pub fn run(
                     break;
                 }
                 stepped = true;
+                let g = motion.state(sim.time()).apparent_gravity(params.gravity);
+                match gravity_check.add(sim.time(), g, params.gravity, input_kind) {
+                    Some(Ok(())) => counters.input_check = "ok".into(),
+                    Some(Err(w)) => {
+                        log(ros2_client::ros2::LogLevel::Warn, &w);
+                        counters.input_check = w;
+                    }
+                    None => {}
+                }
                 // Fetch input between steps so that the reader's short history (keep last 5) never
                 // overflows while a long stretch is stepped.
-                while let Some((stamp, reading)) =
-                    input.take(recorder.as_mut().map(|r| (r, in_topic.as_str())))?
-                {
-                    pending.push((stamp, reading, wall(), unix_now()));
+                while let Some(taken) = input.take(rec_topic.as_deref())? {
+                    pending.push((taken, wall(), unix_now()));
                 }
                 let t = sim.time();
                 if t >= next_output as f64 / rate - 1e-9 {
@@ -1015,6 +1078,7 @@ pub fn run(
                     steps_at_output = sim.stats().steps;
                     if let Some(pc) = &pub_clock {
                         publish(pc, Clock { clock: stamp }, "/clock")?;
+                        last_clock = Some(stamp);
                     }
                     counters.published += 1;
                     if c.particles.rate_hz > 0.0
@@ -1051,7 +1115,20 @@ pub fn run(
             if error.is_some() {
                 break;
             }
-            if pacing.record(wall(), sim.time(), until) && wall() - last_warn > 1.0 {
+            // Lockstep: /clock also says where the simulation stopped for want of input, so a publisher
+            // pacing itself by /clock (`slosh motion --lockstep`) sends the next samples even when the
+            // output period is longer than its lead.
+            if let (Some(pc), true) = (&pub_clock, stepped) {
+                let now = Time::from_secs_f64(base + sim.time());
+                if last_clock != Some(now) {
+                    publish(pc, Clock { clock: now }, "/clock")?;
+                    last_clock = Some(now);
+                }
+            }
+            // Held samples (no input) are no input to fall behind: they come in a stretch of
+            // motion_timeout_s at once.
+            let input_until = if holding { sim.time() } else { until };
+            if pacing.record(wall(), sim.time(), input_until) && wall() - last_warn > 1.0 {
                 last_warn = wall();
                 log(
                     ros2_client::ros2::LogLevel::Warn,
@@ -1121,6 +1198,9 @@ pub fn run(
         )
     });
     if let Some(mut r) = recorder.take() {
+        for s in other_base.drain(..) {
+            s.record_refused(&mut r)?;
+        }
         if let Some(d) = failure.as_ref().filter(|d| d.header.stamp.as_nanos() > 0) {
             let _ = r.write(&diag_topic, d.header.stamp, d);
         }
@@ -1182,9 +1262,10 @@ fn diagnostics(
     wall: f64,
 ) -> DiagnosticArray {
     let (counts, stats) = (sim.counts(), sim.stats());
-    let level = if state == "running" {
+    let level = if state == "running" && !c.input_check.starts_with("input check") {
         DiagnosticStatus::OK
-    } else if stamp.is_none()
+    } else if state == "running"
+        || stamp.is_none()
         || state.starts_with("behind")
         || state.starts_with("paused")
         || state.starts_with("waiting")
@@ -1235,6 +1316,14 @@ fn diagnostics(
                 kv("samples_rejected", c.rejected.to_string()),
                 kv("last_rejection", c.last_reject.clone()),
                 kv("input_timeouts", c.timeouts.to_string()),
+                kv(
+                    "input_check",
+                    if c.input_check.is_empty() {
+                        "pending".into()
+                    } else {
+                        c.input_check.clone()
+                    },
+                ),
                 kv("overruns", pacing.overruns.to_string()),
                 kv("outputs_published", c.published.to_string()),
             ],
