@@ -11,7 +11,7 @@ use ros2_client::{
 };
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus};
-use slosh_msgs::geometry_msgs::{Accel, AccelStamped, Vector3, WrenchStamped};
+use slosh_msgs::geometry_msgs::{Accel, AccelStamped, PoseStamped, Vector3, WrenchStamped};
 use slosh_msgs::geometry_msgs::{Pose, PoseWithCovariance, Quaternion, TwistWithCovariance};
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
@@ -819,6 +819,21 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
             .any(|(l, m)| *l <= 1 && !m.contains("no motion input")),
         "diagnostics did not recover: {states:?}"
     );
+    // Silence again, then the input comes back with stamps that stood still meanwhile (they continue from the
+    // last one sent, behind the pose the node held): the node follows them at once.
+    let _ = watch(1.2, &mut last);
+    let mut states = Vec::new();
+    for k in 0..50 {
+        let _ = odom.publish(rest_odometry(303.6 + k as f64 * 0.02));
+        states.extend(watch(0.02, &mut last));
+    }
+    assert!(
+        states
+            .iter()
+            .skip(3)
+            .any(|(l, m)| *l <= 1 && !m.contains("no motion input")),
+        "diagnostics did not recover from input whose stamps stood still: {states:?}"
+    );
     // SIGTERM: a clean exit, promptly.
     let pid = proc.0.id().to_string();
     assert!(Command::new("kill")
@@ -1000,6 +1015,40 @@ fn lockstep_motion_ends_when_the_node_it_follows_has_exited() {
         "{status}: {log}"
     );
     drop(node_proc);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_publisher_of_another_type_on_the_motion_topic_is_named() {
+    if !common::in_private_netns("a_publisher_of_another_type_on_the_motion_topic_is_named") {
+        return;
+    }
+    let dir = common::tmp("ros-wrong-type");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case("")).unwrap();
+    let (_ctx, mut node) = test_node(52, "e2e_wrong_type");
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    // PoseStamped on the topic where the node takes Odometry (input.type odom). DDS delivers it (it matches
+    // by topic name): the node refuses what it cannot decode, goes on, and names the publisher's type.
+    let pose = publisher::<PoseStamped>(&mut node, "/motion", "odom", &qos);
+    let proc = logged_node(&node, &case, &[], 52, &["/motion/odom"]);
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_secs_f64(6.5) {
+        let m = rest_odometry(1000.0 + start.elapsed().as_secs_f64());
+        let _ = pose.publish(PoseStamped {
+            header: m.header,
+            pose: m.pose.pose,
+        });
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let log = stop_logged(proc);
+    assert!(
+        log.contains("no motion sample yet after")
+            && log.contains("that cannot be decoded as nav_msgs/msg/Odometry")
+            && log.contains("a publisher on /motion/odom of type geometry_msgs/msg/PoseStamped, not nav_msgs/msg/Odometry")
+            && log.contains("set input.type: pose"),
+        "{log}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

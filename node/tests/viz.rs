@@ -187,6 +187,22 @@ fn plot_draws_images_of_the_requested_size_that_change_with_the_data() {
     assert!(std::fs::read_to_string(a.join("plots/probes.svg"))
         .unwrap()
         .contains("measured"));
+    // A reference whose values all lie between gaps (NaN) is drawn as dots, not left out.
+    let sparse = dir.join("sparse.csv");
+    std::fs::write(
+        &sparse,
+        "time,a\n0.0,0.19\n0.5,nan\n1.0,0.22\n1.5,nan\n2.0,0.16\n",
+    )
+    .unwrap();
+    let o = plot(
+        &b,
+        &["--size", "640x480", "--reference", sparse.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        orange(&image(&b.join("plots/probes.png"))) > 60,
+        "the sparse reference is not drawn"
+    );
     // The wrench figure has no reference column: unchanged.
     assert_eq!(image(&a.join("plots/wrench.png")), {
         let o = plot(&a, &["--size", "640x480"]);

@@ -150,7 +150,10 @@ where
         };
         let style = colour.stroke_width(2);
         for (i, seg) in segments(s).into_iter().enumerate() {
-            let drawn = if s.reference {
+            // A value between two gaps (NaN) has no line to be part of: a dot.
+            let drawn = if seg.len() == 1 {
+                chart.draw_series(std::iter::once(Circle::new(seg[0], 3, colour.filled())))
+            } else if s.reference {
                 chart.draw_series(DashedLineSeries::new(seg, 8, 3, style))
             } else {
                 chart.draw_series(LineSeries::new(seg, style))

@@ -5,6 +5,7 @@ pub mod args;
 pub mod cloud;
 pub mod convert;
 pub mod frames;
+pub mod graph_hint;
 pub mod gravity_check;
 pub mod live;
 pub mod live_imu;

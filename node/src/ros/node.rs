@@ -278,10 +278,31 @@ impl Input {
         }
     }
 
+    /// The ROS type taken (iceoryx2: what it is recorded as).
+    fn type_name(kind: InputType) -> &'static str {
+        match kind {
+            InputType::Odom | InputType::Iceoryx2 => "nav_msgs/msg/Odometry",
+            InputType::Pose => "geometry_msgs/msg/PoseStamped",
+            InputType::Imu => "sensor_msgs/msg/Imu",
+        }
+    }
+
     /// The next received sample: (header stamp, reading, the messages to record, serialized for the topic
-    /// `rec` when given). The node records them once it has taken or refused the sample.
-    fn take(&self, rec: Option<&str>) -> anyhow::Result<Option<Taken>> {
-        let err = |what: &str, e: ros2_client::ReadError| anyhow::anyhow!("reading {what}: {e:?}");
+    /// `rec` when given), or why a message received could not be decoded (DDS delivers a publisher of another
+    /// type on the same topic name). The node records samples once it has taken or refused them.
+    fn take(&self, rec: Option<&str>) -> anyhow::Result<Option<Result<Taken, String>>> {
+        match self.take_decoded(rec) {
+            Ok(t) => Ok(t.map(Ok)),
+            Err(e) => match e.downcast::<ros2_client::ReadError>() {
+                Ok(ros2_client::ReadError::Deserialization { reason }) => Ok(Some(Err(reason))),
+                Ok(other) => Err(anyhow::anyhow!("reading the motion input: {other:?}")),
+                Err(e) => Err(e),
+            },
+        }
+    }
+
+    fn take_decoded(&self, rec: Option<&str>) -> anyhow::Result<Option<Taken>> {
+        let err = |_what: &str, e: ros2_client::ReadError| anyhow::Error::from(e);
         fn keep<M: slosh_msgs::RosMessage>(rec: Option<&str>, m: &M) -> Vec<RawMessage> {
             rec.map(|topic| vec![RawMessage::of(topic, m)])
                 .unwrap_or_default()
@@ -331,6 +352,21 @@ impl Input {
             },
         })
     }
+}
+
+/// (DDS topic name, DDS type name) of every publisher the graph shows.
+fn writers_on_graph(context: &ros2_client::Context) -> Vec<(String, String)> {
+    context
+        .domain_participant()
+        .discovered_writers()
+        .into_iter()
+        .map(|w| {
+            (
+                w.publication_topic_data.topic_name,
+                w.publication_topic_data.type_name,
+            )
+        })
+        .collect()
 }
 
 /// A received sample: its header stamp, its messages for the recording, the reading.
@@ -659,6 +695,8 @@ pub fn run(
     let mut tf_sent = false;
     let mut gravity_check = GravityCheck::default();
     let mut last_clock: Option<Time> = None;
+    let mut undecodable: Vec<String> = Vec::new();
+    let mut last_undecodable = f64::NEG_INFINITY;
     let input_kind = match c.input.kind {
         InputType::Odom | InputType::Pose => InputKind::Pose,
         InputType::Imu => InputKind::Imu,
@@ -740,7 +778,43 @@ pub fn run(
         // 1. Drain the input (and what was fetched while stepping).
         let mut got = false;
         while let Some(taken) = input.take(rec_topic.as_deref())? {
-            pending.push((taken, wall(), unix_now()));
+            match taken {
+                Ok(t) => pending.push((t, wall(), unix_now())),
+                Err(reason) => {
+                    undecodable.push(reason);
+                    break;
+                }
+            }
+        }
+        // Messages that could not be decoded: refused and said, with what the graph shows (a publisher of
+        // another type on the topic).
+        if let Some(reason) = undecodable.last().cloned() {
+            counters.rejected += undecodable.len() as u64;
+            counters.last_reject = format!("undecodable message: {reason}");
+            if wall() - last_undecodable > 10.0 {
+                last_undecodable = wall();
+                let hint = super::graph_hint::hint(
+                    &in_topic,
+                    Input::topic(c.input.kind),
+                    Input::type_name(c.input.kind),
+                    &writers_on_graph(&context),
+                )
+                .unwrap_or_else(|| {
+                    format!(
+                        "is every publisher on it sending {}?",
+                        Input::type_name(c.input.kind)
+                    )
+                });
+                log(
+                    ros2_client::ros2::LogLevel::Warn,
+                    &format!(
+                        "refused {} message(s) on {in_topic} that cannot be decoded as {} ({reason}): {hint}",
+                        undecodable.len(),
+                        Input::type_name(c.input.kind)
+                    ),
+                );
+            }
+            undecodable.clear();
         }
         let mut incoming: VecDeque<Sample> = pending
             .drain(..)
@@ -810,6 +884,29 @@ pub fn run(
                         holding = false;
                         log(ros2_client::ros2::LogLevel::Info, "motion input is back");
                     }
+                }
+                // The input back after a timeout with stamps behind the held pose's (its clock stood still
+                // while it was away, or runs behind the node's): held samples are the node's own, so it
+                // follows the input's stamps at once, from the simulation's present, as after a pause.
+                Err(_)
+                    if holding
+                        && gap.is_none()
+                        && newest_stamp.is_none_or(|n| ts > n)
+                        && motion.newest().is_some_and(|n| ts - base <= n) =>
+                {
+                    log(
+                        ros2_client::ros2::LogLevel::Info,
+                        &format!(
+                            "motion input is back, its stamps {:.3} s behind the held pose's: following them from t = {:.4} s",
+                            motion.newest().unwrap_or(ts - base) - (ts - base),
+                            sim.time()
+                        ),
+                    );
+                    holding = false;
+                    motion = fresh_motion();
+                    rebase = true;
+                    newest_stamp = None;
+                    incoming.push_front(sample);
                 }
                 Err(e) => {
                     counters.rejected += 1;
@@ -918,7 +1015,12 @@ pub fn run(
                         if c.input.kind == InputType::Iceoryx2 {
                             format!("iceoryx2 service {}/motion: is its publisher (e.g. `slosh motion CASE --iceoryx2 {}`) running?", iox.service, iox.service)
                         } else {
-                            format!("{in_topic}: is the publisher running, on this ROS_DOMAIN_ID, and is the topic remapped right (-r {}:=NAME)?", Input::topic(c.input.kind))
+                            let writers = writers_on_graph(&context);
+                            let name = Input::topic(c.input.kind);
+                            match super::graph_hint::hint(&in_topic, name, Input::type_name(c.input.kind), &writers) {
+                                Some(h) => format!("{in_topic}: {h}"),
+                                None => format!("{in_topic}: is the publisher running, on this ROS_DOMAIN_ID, and is the topic remapped right (-r {name}:=NAME)?"),
+                            }
                         }
                     ),
                 );
@@ -1045,7 +1147,13 @@ pub fn run(
                 // Fetch input between steps so that the reader's short history (keep last 5) never
                 // overflows while a long stretch is stepped.
                 while let Some(taken) = input.take(rec_topic.as_deref())? {
-                    pending.push((taken, wall(), unix_now()));
+                    match taken {
+                        Ok(t) => pending.push((t, wall(), unix_now())),
+                        Err(reason) => {
+                            undecodable.push(reason);
+                            break;
+                        }
+                    }
                 }
                 let t = sim.time();
                 if t >= next_output as f64 / rate - 1e-9 {
