@@ -1206,6 +1206,42 @@ mod tests {
     }
 
     #[test]
+    fn the_kernel_gradient_follows_the_scheme_unless_set() {
+        use sph::kernel::KernelGradient::{Exact, ThomasCouchman};
+        let gradient = |o: &[&str]| {
+            let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
+            let p = from_str(MIN, "case.yaml", None, &o)
+                .unwrap()
+                .sim_params()
+                .unwrap();
+            p.solver.kernel_gradient()
+        };
+        assert_eq!(gradient(&[]), Exact);
+        assert_eq!(gradient(&["solver.scheme=dfsph"]), ThomasCouchman);
+        assert_eq!(
+            gradient(&["solver.scheme=dfsph", "solver.kernel_gradient=exact"]),
+            Exact
+        );
+        assert_eq!(
+            gradient(&["solver.kernel_gradient=thomas_couchman"]),
+            ThomasCouchman
+        );
+        let e = err(
+            MIN,
+            &[
+                "solver.kernel=wendland",
+                "solver.kernel_gradient=thomas_couchman",
+            ],
+        );
+        assert!(
+            e.contains("solver.kernel_gradient: thomas_couchman is for the cubic spline"),
+            "{e}"
+        );
+        let e = err(MIN, &["solver.kernel_gradient=tc"]);
+        assert!(e.contains("`exact` or `thomas_couchman`"), "{e}");
+    }
+
+    #[test]
     fn overrides_are_parsed_as_yaml() {
         let o = vec![
             "probes.names=[a, b]".to_string(),

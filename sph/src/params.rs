@@ -1,7 +1,7 @@
 //! The typed description of a case: tank, liquid, resolution, solver choices and observation points.
 //! Plain data with defaults; [`SimParams::validate`] names the offending field of anything unusable.
 
-use crate::kernel::KernelKind;
+use crate::kernel::{KernelGradient, KernelKind};
 use serde::{Deserialize, Serialize};
 
 /// A closed rectangular tank. Tank frame: origin at the centre of the tank bottom, x along `length`,
@@ -192,6 +192,9 @@ impl Default for BoundarySpec {
 pub struct SolverSpec {
     pub scheme: Scheme,
     pub kernel: KernelKind,
+    /// How the cubic spline's gradient is taken ([`KernelGradient`]); unset: the scheme's choice
+    /// ([`SolverSpec::kernel_gradient`]).
+    pub kernel_gradient: Option<KernelGradient>,
     /// h / particle spacing.
     pub smoothing_ratio: f64,
     pub integrator: Integrator,
@@ -218,11 +221,24 @@ pub struct SolverSpec {
     pub dfsph: DfsphSpec,
 }
 
+impl SolverSpec {
+    /// The kernel gradient this run uses: the one set, else Thomas & Couchman's for the incompressible
+    /// scheme (with the exact one its liquid pairs up, at rest too) and the exact one, the paper's, for
+    /// the weakly-compressible scheme.
+    pub fn kernel_gradient(&self) -> KernelGradient {
+        self.kernel_gradient.unwrap_or(match self.scheme {
+            Scheme::Dfsph => KernelGradient::ThomasCouchman,
+            Scheme::Wcsph => KernelGradient::Exact,
+        })
+    }
+}
+
 impl Default for SolverSpec {
     fn default() -> Self {
         Self {
             scheme: Scheme::Wcsph,
             kernel: KernelKind::CubicSpline,
+            kernel_gradient: None,
             smoothing_ratio: 1.3,
             integrator: Integrator::Symplectic,
             cfl: 0.2,
@@ -454,6 +470,14 @@ impl SimParams {
 
     /// Checks every field; the error names the first unusable one.
     pub fn validate(&self) -> Result<(), ParamError> {
+        if self.solver.kernel == KernelKind::Wendland
+            && self.solver.kernel_gradient == Some(KernelGradient::ThomasCouchman)
+        {
+            return Err(err(
+                "solver.kernel_gradient",
+                "thomas_couchman is for the cubic spline (the Wendland kernel's gradient does not vanish between close particles): leave it unset or set `exact`",
+            ));
+        }
         if self.solver.scheme == Scheme::Dfsph {
             let d = &self.solver.dfsph;
             if self.solver.boundary.method != BoundaryMethod::Dynamic {

@@ -106,7 +106,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let c0 = params.sound_speed();
         let rho0 = params.fluid.density;
         let eos = Tait::new(rho0, c0);
-        let kernel = K::new(D, h as f32);
+        let kernel = K::new(D, h as f32).with_gradient(params.solver.kernel_gradient());
         let tank = TankBox::<D>::new(&params);
         let layers = params.wall_layers();
         let support = kernel.support() as f64;
