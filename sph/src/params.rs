@@ -71,8 +71,8 @@ pub struct DfsphSpec {
     /// `max_iterations` above the tolerance is solved again at half the step. 0 turns both off.
     pub target_iterations: u32,
     /// Share β of the hydrostatic pressure (per column of the liquid, below its highest particle) that the
-    /// constant-density solve carries over whole from the last step; the rest of the last pressure is
-    /// halved (`sph::scheme::warm_start`). 0: half the whole last pressure (Bender & Koschier 2017), as
+    /// constant-density solve carries over whole from the last step; of the rest of the last pressure it
+    /// carries 0.6 (`sph::scheme::warm_start::REST`). 0: half the whole last pressure (Bender & Koschier 2017), as
     /// always with bodies (floating bodies, fixed or not, a wave maker) and with `smoothing_ratio` < 1.
     pub hydrostatic_warm_start: f64,
 }

@@ -626,9 +626,9 @@ fn paired_share(sim: &dyn Solver) -> f64 {
 #[test]
 fn dfsph_liquid_at_rest_keeps_its_particles_apart() {
     // With the cubic spline's exact gradient (|dW/dr| → 0 as two particles meet) the incompressible
-    // scheme's liquid pairs up, at rest too: here 61 % (2D) and 55 % (3D) of the particles within 2 s
+    // scheme's liquid pairs up, at rest too: here 62 % (2D) and 57 % (3D) of the particles within 2 s
     // (the seed tank at dp 20 mm in 3D: 72 % after 3 s, and at 1.5 ms steps its liquid rose 9 %). The
-    // Thomas & Couchman gradient, the scheme's default, keeps them apart (0.5 % and 1.3 % here).
+    // Thomas & Couchman gradient, the scheme's default, keeps them apart (0.5 % and 0.9 % here).
     let mut p2 = dfsph(tank2d(0.4, 0.3, 0.2, 0.01));
     p2.solver.dfsph.dt_max = 0.0025;
     let mut p3 = dfsph(tank2d(0.3, 0.3, 0.2, 0.02));
@@ -798,7 +798,10 @@ fn dfsph_iteration_control_keeps_every_step_converged() {
         sim.stats()
     };
     let free = run(0);
-    let controlled = run(6);
+    // (A target of a third of the cap: at 6, half of it, the steps the control shortened were barely
+    // cheaper once the warm start carried 0.6 of the last non-hydrostatic pressure instead of half: 4.25
+    // iterations a step against 4.12 without the control, as retried steps count their failed tries.)
+    let controlled = run(4);
     eprintln!("uncontrolled {free:?}\ncontrolled {controlled:?}");
     assert!(free.unconverged_steps > 0, "{free:?}");
     assert_eq!(free.retried_steps, 0);

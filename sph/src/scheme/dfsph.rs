@@ -12,7 +12,7 @@
 //! 3. makes the velocity field divergence-free (the divergence solver), then predicts v* = v + dt·a and
 //!    corrects it until the mean predicted density error is below the tolerance (the constant-density
 //!    solver). The divergence solve starts from half its last pressure, the constant-density solve from the
-//!    hydrostatic part of its last pressure whole and the rest halved (`warm_start`); both iterate
+//!    hydrostatic part of its last pressure whole and 0.6 of the rest (`warm_start`); both iterate
 //!    `k_i = ω · max(error_i, 0) · α_i / dt^n` (ω = `relaxation`, 0.7: at 1 the Jacobi iterations amplify
 //!    the particle-to-particle pressure modes of the 3D kernel's 81 neighbours and a tank at rest stirs
 //!    itself),
