@@ -512,6 +512,29 @@ pub struct Loaded {
     pub flag: &'static str,
 }
 
+/// serde's type errors in a user's words: "expected struct AutoResolutionCfg" (a value given where a group of
+/// parameters belongs) and Rust's integer type names.
+fn plain_type_error(message: &str, key: &str) -> String {
+    if let Some((head, _)) = message.split_once(", expected struct ") {
+        let got = head.strip_prefix("invalid type: ").unwrap_or(head);
+        return format!(
+            "a group of parameters, not one value (got {got}): set its members by name (`{key}.MEMBER`, e.g. with -p {key}.MEMBER:=VALUE, or nested under `{key}` in the file; see the README's parameter tables)"
+        );
+    }
+    for (rust, plain) in [
+        ("expected usize", "expected a whole number"),
+        ("expected u64", "expected a whole number"),
+        ("expected u32", "expected a whole number"),
+        ("expected u16", "expected a whole number"),
+        ("expected f64", "expected a number"),
+    ] {
+        if let Some(head) = message.strip_suffix(rust) {
+            return format!("{head}{plain}");
+        }
+    }
+    message.to_string()
+}
+
 /// Reads a config file, or a built-in case by name, and applies `--set` overrides. A file with several node
 /// sections is read as the node `slosh` would read it (see [`load_node`]); a single section is read whatever
 /// node it names.
@@ -697,6 +720,7 @@ fn finish(
     }
     let mut config: RunConfig = serde_path_to_error::deserialize(params.clone()).map_err(|e| {
         let key = e.path().to_string();
+        let path = key.clone();
         // An error in a parameter an override set (or in a group it set) is the override's.
         let given = keys.iter().any(|k| {
             *k == key || key.starts_with(&format!("{k}.")) || k.starts_with(&format!("{key}."))
@@ -708,7 +732,7 @@ fn finish(
             } else {
                 key
             },
-            message: e.into_inner().to_string(),
+            message: plain_type_error(&e.into_inner().to_string(), &path),
         }
     })?;
     if config.use_sim_time && config.realtime.mode == RealtimeMode::Realtime {
@@ -1260,6 +1284,19 @@ mod tests {
     #[test]
     fn wrong_types_and_values_name_the_key() {
         assert!(err(MIN, &["particle_spacing=fine"]).contains("particle_spacing: invalid type"));
+        // serde's type names in a user's words.
+        let e = err(MIN, &["realtime.auto_resolution=true"]);
+        assert!(
+            e.contains("realtime.auto_resolution: a group of parameters, not one value (got boolean `true`)")
+                && e.contains("realtime.auto_resolution.MEMBER")
+                && !e.contains("AutoResolutionCfg"),
+            "{e}"
+        );
+        let e = err(MIN, &["dimension=3D"]);
+        assert!(
+            e.contains("expected a whole number") && !e.contains("usize"),
+            "{e}"
+        );
         assert!(
             err(MIN, &["fill_height=0.7"]).contains("fill_height: 0.7 m is above the tank height")
         );

@@ -149,9 +149,25 @@ impl RawMessage {
     }
 }
 
+/// The name of the MCAP metadata record that documents a recording's run.
+pub const PARAMETERS_RECORD: &str = "slosh_parameters";
+
+/// The entries of the [`PARAMETERS_RECORD`] for a run's parameters (as JSON under `parameters`).
+pub fn parameters_metadata(parameters: &serde_json::Value) -> BTreeMap<String, String> {
+    BTreeMap::from([("parameters".to_string(), parameters.to_string())])
+}
+
 impl Recorder {
     /// Creates the rosbag2 folder `cfg.path` (which must not exist yet, or be empty) and its MCAP file.
     pub fn create(cfg: &RecordCfg, parameters: &serde_json::Value) -> Result<Self, RecordError> {
+        Self::create_with_metadata(cfg, parameters_metadata(parameters))
+    }
+
+    /// [`Recorder::create`] with the [`PARAMETERS_RECORD`]'s entries given whole.
+    pub fn create_with_metadata(
+        cfg: &RecordCfg,
+        meta: BTreeMap<String, String>,
+    ) -> Result<Self, RecordError> {
         let dir = PathBuf::from(&cfg.path);
         let err = |message: String| RecordError::Path {
             what: cfg.chosen_by.label(),
@@ -188,11 +204,9 @@ impl Recorder {
             .chunk_size(Some(cfg.chunk_size))
             .create(BufWriter::new(file))
             .map_err(|e| err(format!("cannot start the MCAP file: {}", with_causes(&e))))?;
-        let mut meta = BTreeMap::new();
-        meta.insert("parameters".to_string(), parameters.to_string());
         writer
             .write_metadata(&mcap::records::Metadata {
-                name: "slosh_parameters".into(),
+                name: PARAMETERS_RECORD.into(),
                 metadata: meta,
             })
             .map_err(|e| err(format!("cannot write the parameters: {}", with_causes(&e))))?;
@@ -443,10 +457,13 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
         chosen_by: ChosenBy::RepairOut,
         ..Default::default()
     };
-    let mut rec = Recorder::create(
-        &cfg,
-        &serde_json::json!({"repaired_from": input.display().to_string()}),
-    )?;
+    // The damaged bag's own parameters record, where it survived (it is written first), goes with it.
+    let mut meta = files
+        .first()
+        .and_then(|f| surviving_parameters(f))
+        .unwrap_or_default();
+    meta.insert("repaired_from".into(), input.display().to_string());
+    let mut rec = Recorder::create_with_metadata(&cfg, meta)?;
     let mut n = 0;
     let mut stops = Vec::new();
     for file in &files {
@@ -508,6 +525,29 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
         files: files.len(),
         stopped: (!stops.is_empty()).then(|| stops.join("; ")),
     })
+}
+
+/// The entries of `file`'s [`PARAMETERS_RECORD`], read record by record up to the first damaged one (an
+/// unfinished file has no summary to find it by).
+fn surviving_parameters(file: &Path) -> Option<BTreeMap<String, String>> {
+    let f = std::fs::File::open(file).ok()?;
+    // SAFETY: only read while this function runs (as in `repair`).
+    let bytes = unsafe { memmap2::Mmap::map(&f) }.ok()?;
+    let reader = mcap::read::LinearReader::new_with_options(
+        &bytes,
+        mcap::read::Options::IgnoreEndMagic.into(),
+    )
+    .ok()?;
+    for record in reader {
+        match record {
+            Ok(mcap::records::Record::Metadata(m)) if m.name == PARAMETERS_RECORD => {
+                return Some(m.metadata)
+            }
+            Ok(_) => {}
+            Err(_) => return None,
+        }
+    }
+    None
 }
 
 /// The MCAP files to repair, in order: the one file given; a bag folder's files in the order its

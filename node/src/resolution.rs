@@ -5,6 +5,7 @@
 
 use crate::config::Loaded;
 use sph::params::SimParams;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// What `realtime.auto_resolution.*` configures.
@@ -39,6 +40,10 @@ pub struct Choice {
     pub trials: Vec<(f64, f64)>,
     /// The target was met (else the coarsest spacing is used anyway).
     pub met: bool,
+    /// The trials' target real-time factor.
+    pub target_factor: f64,
+    /// Candidate spacings left out because the case is not valid at them (spacing, why), coarsest first.
+    pub skipped: Vec<(f64, String)>,
 }
 
 impl Choice {
@@ -50,7 +55,7 @@ impl Choice {
             .map(|(dp, f)| format!("{:.4} m: {f:.2}", dp))
             .collect();
         format!(
-            "dp {:.4} m, trial real-time factor {:.2}{} (tried {})",
+            "dp {:.4} m, trial real-time factor {:.2}{} (target {:.2}; tried {})",
             self.particle_spacing,
             self.realtime_factor,
             if self.met {
@@ -58,6 +63,7 @@ impl Choice {
             } else {
                 ", below the target even at the coarsest spacing"
             },
+            self.target_factor,
             tried.join(", ")
         )
     }
@@ -75,36 +81,78 @@ pub fn candidates(finest: f64, coarsest: f64) -> Vec<f64> {
     v
 }
 
-/// Chooses the spacing (see the module docs).
-pub fn choose(cfg: &Loaded, auto: &AutoResolutionCfg) -> anyhow::Result<Choice> {
-    let base: SimParams = cfg.sim_params()?;
-    if !(auto.trial_s > 0.0 && auto.target_factor > 0.0) {
-        anyhow::bail!("realtime.auto_resolution: trial_s and target_factor must be positive");
+impl AutoResolutionCfg {
+    /// The settings' own checks, before any trial: each bad value named with where it came from.
+    pub fn check(&self, cfg: &Loaded) -> anyhow::Result<()> {
+        let key = "realtime.auto_resolution";
+        for (name, v, what) in [
+            ("trial_s", self.trial_s, "simulated seconds each trial runs"),
+            (
+                "target_factor",
+                self.target_factor,
+                "real-time factor a trial must reach, e.g. 1.25",
+            ),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                anyhow::bail!(
+                    "{}: {key}.{name}: must be a positive number ({what}), got {v}",
+                    cfg.source_of(&format!("{key}.{name}"))
+                );
+            }
+        }
+        let finest = cfg.config.particle_spacing;
+        if !(self.max_spacing.is_finite() && self.max_spacing >= 0.0)
+            || (self.max_spacing > 0.0 && self.max_spacing < finest)
+        {
+            anyhow::bail!(
+                "{}: {key}.max_spacing: must be 0 (4 × particle_spacing) or at least particle_spacing ({finest} m, the finest spacing tried), got {}",
+                cfg.source_of(&format!("{key}.max_spacing")),
+                self.max_spacing
+            );
+        }
+        Ok(())
     }
+}
+
+/// Chooses the spacing (see the module docs). `None` when `stop` was set during the trials (SIGINT or
+/// SIGTERM): the caller stops as cleanly as it would have later.
+pub fn choose(
+    cfg: &Loaded,
+    auto: &AutoResolutionCfg,
+    stop: &AtomicBool,
+) -> anyhow::Result<Option<Choice>> {
+    let base: SimParams = cfg.sim_params()?;
+    auto.check(cfg)?;
     let coarsest = if auto.max_spacing > 0.0 {
         auto.max_spacing
     } else {
         4.0 * base.particle_spacing
     };
-    if coarsest < base.particle_spacing {
-        anyhow::bail!(
-            "realtime.auto_resolution.max_spacing ({coarsest} m) is finer than particle_spacing ({} m)",
-            base.particle_spacing
-        );
-    }
     let motion = crate::motion_source::build(cfg)?;
     let mut trials = vec![];
+    let mut skipped = vec![];
     let mut best: Option<(f64, f64)> = None;
     for dp in candidates(base.particle_spacing, coarsest) {
         let mut p = base.clone();
         p.particle_spacing = dp;
-        if p.validate().is_err() {
+        if let Err(e) = p.validate() {
+            skipped.push((dp, e.to_string()));
             continue;
+        }
+        if stop.load(Ordering::Relaxed) {
+            return Ok(None);
         }
         let mut sim = sph::build(p)?;
         let t = auto.trial_s.min(motion.end_time());
         let start = Instant::now();
-        sim.advance_to(motion.as_ref(), t)?;
+        // In slices, so that a signal stops the trials within a moment (advance_to enters the thread
+        // pool once per call; a slice is many steps).
+        while sim.time() < t {
+            if stop.load(Ordering::Relaxed) {
+                return Ok(None);
+            }
+            sim.advance_to(motion.as_ref(), (sim.time() + 0.02).min(t))?;
+        }
         let rtf = sim.time() / start.elapsed().as_secs_f64();
         trials.push((dp, rtf));
         if rtf >= auto.target_factor {
@@ -114,22 +162,23 @@ pub fn choose(cfg: &Loaded, auto: &AutoResolutionCfg) -> anyhow::Result<Choice> 
         }
     }
     let Some(&(coarse_dp, coarse_rtf)) = trials.first() else {
-        anyhow::bail!("realtime.auto_resolution: no valid particle spacing between particle_spacing and max_spacing");
+        let why = skipped
+            .last()
+            .map_or(String::new(), |(dp, e)| format!(" (at {dp:.4} m: {e})"));
+        anyhow::bail!("realtime.auto_resolution: no valid particle spacing between particle_spacing and max_spacing{why}");
     };
-    Ok(match best {
-        Some((dp, rtf)) => Choice {
-            particle_spacing: dp,
-            realtime_factor: rtf,
-            trials,
-            met: true,
-        },
-        None => Choice {
-            particle_spacing: coarse_dp,
-            realtime_factor: coarse_rtf,
-            trials,
-            met: false,
-        },
-    })
+    let (particle_spacing, realtime_factor, met) = match best {
+        Some((dp, rtf)) => (dp, rtf, true),
+        None => (coarse_dp, coarse_rtf, false),
+    };
+    Ok(Some(Choice {
+        particle_spacing,
+        realtime_factor,
+        trials,
+        met,
+        target_factor: auto.target_factor,
+        skipped,
+    }))
 }
 
 #[cfg(test)]
@@ -155,7 +204,9 @@ mod tests {
             trial_s: 0.1,
             target_factor: 1.0,
         };
-        let c = choose(&cfg, &auto).unwrap();
+        let c = choose(&cfg, &auto, &AtomicBool::new(false))
+            .unwrap()
+            .unwrap();
         // Trials go from coarse to fine and stop at the first that misses the target; the choice is the last
         // that met it (or the coarsest).
         assert!(!c.trials.is_empty());
@@ -168,5 +219,41 @@ mod tests {
             assert_eq!(c.particle_spacing, c.trials[0].0);
         }
         assert!(c.describe().contains("trial real-time factor"));
+        assert!(c.describe().contains("(target 1.00;"));
+        // Spacings coarser than the tank allows are listed as left out, not silently dropped.
+        let coarse = AutoResolutionCfg {
+            max_spacing: 0.5,
+            ..auto
+        };
+        let c = choose(&cfg, &coarse, &AtomicBool::new(false))
+            .unwrap()
+            .unwrap();
+        assert!(!c.skipped.is_empty() && c.skipped.iter().all(|(dp, _)| *dp > c.trials[0].0));
+        // A signal before (or during) the trials ends them with no choice.
+        assert_eq!(choose(&cfg, &auto, &AtomicBool::new(true)).unwrap(), None);
+    }
+
+    #[test]
+    fn bad_settings_are_named_before_any_trial() {
+        let text = "slosh:\n  ros__parameters:\n    dimension: 2\n    tank: {length: 0.8, breadth: 0.25, height: 0.6}\n    fill_height: 0.19\n    particle_spacing: 0.01\n";
+        let msg = |over: &[&str]| {
+            let o: Vec<String> = over.iter().map(|s| s.to_string()).collect();
+            let cfg = crate::config::from_str(text, "case.yaml", None, &o).unwrap();
+            let auto = cfg.config.realtime.auto_resolution;
+            auto.check(&cfg).unwrap_err().to_string()
+        };
+        let m = msg(&["realtime.auto_resolution.trial_s=-1"]);
+        assert!(
+            m.contains("realtime.auto_resolution.trial_s: must be a positive number")
+                && m.contains("got -1"),
+            "{m}"
+        );
+        let m = msg(&["realtime.auto_resolution.target_factor=0"]);
+        assert!(m.contains("target_factor") && m.contains("got 0"), "{m}");
+        let m = msg(&["realtime.auto_resolution.max_spacing=0.005"]);
+        assert!(
+            m.contains("max_spacing") && m.contains("at least particle_spacing (0.01 m"),
+            "{m}"
+        );
     }
 }

@@ -180,6 +180,15 @@ fn sigkill_then_repair_recovers_the_complete_chunks() {
         let t = item[0].as_f64().unwrap();
         assert!((t - k as f64 / 20.0).abs() < 0.01, "message {k} at {t}");
     }
+    // The run's parameters record survived the kill (it is written first) and goes with the repair.
+    let meta = &v["metadata"]["slosh_parameters"];
+    let params: serde_json::Value =
+        serde_json::from_str(meta["parameters"].as_str().unwrap_or("null")).unwrap();
+    assert!(params["particle_spacing"].as_f64().is_some(), "{meta}");
+    assert!(
+        meta["repaired_from"].as_str().unwrap().ends_with("bag"),
+        "{meta}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -459,15 +459,23 @@ fn logged_node(
 }
 
 /// Stops a [`logged_node`] with SIGTERM; its log, once it has exited cleanly.
-fn stop_logged(proc: Child) -> String {
+fn stop_logged(mut proc: Child) -> String {
+    stop_logged_in(&mut proc)
+}
+
+/// [`stop_logged`] for a node held in place (by a [`Kill`]).
+fn stop_logged_in(proc: &mut Child) -> String {
     assert!(Command::new("kill")
         .args(["-TERM", &proc.id().to_string()])
         .status()
         .unwrap()
         .success());
-    let out = proc.wait_with_output().unwrap();
-    let log = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(out.status.success(), "{log}");
+    let mut log = String::new();
+    if let Some(mut e) = proc.stderr.take() {
+        std::io::Read::read_to_string(&mut e, &mut log).unwrap();
+    }
+    let status = proc.wait().unwrap();
+    assert!(status.success(), "{log}");
     log
 }
 
@@ -1235,11 +1243,15 @@ fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
     .unwrap();
     let (_ctx, mut node) = test_node(47, "e2e_autores");
     let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
-    let _proc = Kill(
+    let bag = dir.join("bag");
+    let mut proc = Kill(
         slosh()
             .args(["node", "--ros-args", "--params-file"])
             .arg(&case)
+            .arg("-p")
+            .arg(format!("record.path:={}", bag.display()))
             .env("ROS_DOMAIN_ID", "47")
+            .stderr(Stdio::piped())
             .spawn()
             .unwrap(),
     );
@@ -1270,8 +1282,50 @@ fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
         "particle_spacing {dp}"
     );
     assert!(
-        how.contains(&format!("dp {dp:.4} m")) && how.contains("trial real-time factor"),
+        how.contains(&format!("dp {dp:.4} m"))
+            && how.contains("trial real-time factor")
+            && how.contains("(target 1.20;"),
         "{how}"
     );
     assert_eq!(get("scheme"), "dfsph");
+    // The bag's parameters record (read by the mcap reader) gives the spacing run, not the one asked for,
+    // and how it was chosen.
+    let log = stop_logged_in(&mut proc.0);
+    assert!(log.contains("(target real-time factor 1.2)"), "{log}");
+    let meta = &common::read_bag(&bag)["metadata"]["slosh_parameters"];
+    let params: serde_json::Value =
+        serde_json::from_str(meta["parameters"].as_str().unwrap()).unwrap();
+    assert_eq!(params["particle_spacing"].as_f64(), Some(dp), "{meta}");
+    let chosen: serde_json::Value =
+        serde_json::from_str(meta["auto_resolution"].as_str().unwrap()).unwrap();
+    assert_eq!(chosen["requested_particle_spacing"].as_f64(), Some(0.01));
+    assert_eq!(chosen["chosen"]["particle_spacing"].as_f64(), Some(dp));
+    assert!(!chosen["chosen"]["trials"].as_array().unwrap().is_empty());
+
+    // A signal during the trials (here of 60 s each) stops the node at once and cleanly: exit 0, nothing
+    // recorded.
+    let slow = dir.join("slow_bag");
+    let proc = slosh()
+        .args(["node", "--ros-args", "--params-file"])
+        .arg(&case)
+        .args(["-p", "realtime.auto_resolution.trial_s:=60", "-p"])
+        .arg(format!("record.path:={}", slow.display()))
+        .env("ROS_DOMAIN_ID", "47")
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let asked = Instant::now();
+    let log = stop_logged(proc);
+    assert!(
+        asked.elapsed() < Duration::from_secs(10),
+        "took {:?} to stop",
+        asked.elapsed()
+    );
+    assert!(
+        log.contains("interrupted during the resolution trials"),
+        "{log}"
+    );
+    assert!(!slow.exists(), "nothing is recorded");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -80,7 +80,12 @@ pub fn parse(args: &[String]) -> Result<(Vec<String>, RosArgs), ArgError> {
                 "--disable-rosout-logs" | "--disable-stdout-logs" | "--enable-stdout-logs" => {}
                 other => {
                     return Err(ArgError(format!(
-                        "unknown argument `{other}` (accepted: --params-file FILE, -p name:=value, -r from:=to, -r __ns:=/ns, -r __node:=name, --log-level LEVEL)"
+                        "unknown argument `{other}` (accepted: --params-file FILE, -p name:=value, -r from:=to, -r __ns:=/ns, -r __node:=name, --log-level LEVEL){}",
+                        if other.starts_with("--") {
+                            "; slosh's own options, such as --duration, go before --ros-args (or after a closing --)"
+                        } else {
+                            ""
+                        }
                     )))
                 }
             }
@@ -272,6 +277,10 @@ mod tests {
             .unwrap_err()
             .0
             .contains("unknown argument `--bogus`"));
+        assert!(parse(&args("--ros-args --duration 2"))
+            .unwrap_err()
+            .0
+            .contains("--duration, go before --ros-args"));
         assert!(parse(&args("--ros-args -r __ns:=ship"))
             .unwrap_err()
             .0

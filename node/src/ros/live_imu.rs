@@ -85,14 +85,7 @@ impl LiveImu {
             }
             let dt = t - t0;
             let turn = p.orientation.angle_to(&s.orientation);
-            if turn > self.limits.max_rotation_rate * dt {
-                return Err(Rejected::Jump {
-                    what: "orientation",
-                    size: turn,
-                    dt,
-                    limit: self.limits.max_rotation_rate,
-                });
-            }
+            self.limits.turned("orientation", turn, dt)?;
         }
         self.samples.push_back((t, s));
         Ok(())

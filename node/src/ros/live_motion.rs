@@ -21,12 +21,16 @@ pub enum Rejected {
     Duplicate { time: f64 },
     #[error("{0}")]
     Invalid(String),
-    #[error("{what} jumps by {size:.3} in {dt:.4} s, faster than the limit {limit} (input.max_speed / input.max_rotation_rate)")]
+    #[error("{what} jumps by {size:.3} {unit} in {dt:.4} s ({rate:.2} {unit}/s), faster than {param} = {limit} {unit}/s (raise it if the motion is real)", rate = size / dt)]
     Jump {
         what: &'static str,
         size: f64,
         dt: f64,
         limit: f64,
+        /// The parameter that sets `limit`.
+        param: &'static str,
+        /// m or rad.
+        unit: &'static str,
     },
 }
 
@@ -40,15 +44,33 @@ pub struct Limits {
 }
 
 impl Limits {
-    /// Refuses a move of `size` (m or rad) in `dt` s faster than `limit` (`max_speed` or
-    /// `max_rotation_rate`) as a jump of `what`.
-    pub fn jump(what: &'static str, size: f64, dt: f64, limit: f64) -> Result<(), Rejected> {
+    /// Refuses a move of `size` m in `dt` s faster than `max_speed` as a jump of `what`.
+    pub fn moved(&self, what: &'static str, size: f64, dt: f64) -> Result<(), Rejected> {
+        Self::jump(what, size, dt, self.max_speed, "input.max_speed", "m")
+    }
+
+    /// Refuses a turn of `size` rad in `dt` s faster than `max_rotation_rate` as a jump of `what`.
+    pub fn turned(&self, what: &'static str, size: f64, dt: f64) -> Result<(), Rejected> {
+        let limit = self.max_rotation_rate;
+        Self::jump(what, size, dt, limit, "input.max_rotation_rate", "rad")
+    }
+
+    fn jump(
+        what: &'static str,
+        size: f64,
+        dt: f64,
+        limit: f64,
+        param: &'static str,
+        unit: &'static str,
+    ) -> Result<(), Rejected> {
         if size > limit * dt {
             return Err(Rejected::Jump {
                 what,
                 size,
                 dt,
                 limit,
+                param,
+                unit,
             });
         }
         Ok(())
@@ -164,11 +186,11 @@ pub fn check_pose(
     let dt = t - t0;
     let dist =
         ((pose[0] - p0[0]).powi(2) + (pose[1] - p0[1]).powi(2) + (pose[2] - p0[2]).powi(2)).sqrt();
-    Limits::jump("position (m)", dist, dt, limits.max_speed)?;
+    limits.moved("position", dist, dt)?;
     for k in 3..6 {
         let d = pose[k] - p0[k];
         let d = (d - (d / (2.0 * PI)).round() * 2.0 * PI).abs();
-        Limits::jump(NAMES[k], d, dt, limits.max_rotation_rate)?;
+        limits.turned(NAMES[k], d, dt)?;
     }
     Ok(())
 }
@@ -224,10 +246,19 @@ mod tests {
         assert!(matches!(
             m.push(0.2, [5.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
             Err(Rejected::Jump {
-                what: "position (m)",
+                what: "position",
+                param: "input.max_speed",
                 ..
             })
         ));
+        let msg = m
+            .push(0.2, [0.2, 0.0, 0.0, 0.0, 0.0, 1.0])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("yaw jumps by 1.000 rad in 0.1000 s (10.00 rad/s), faster than input.max_rotation_rate = 3 rad/s"),
+            "{msg}"
+        );
         assert!(matches!(
             m.push(0.2, [0.2, 0.0, 0.0, 0.0, 0.0, 1.0]),
             Err(Rejected::Jump { what: "yaw", .. })

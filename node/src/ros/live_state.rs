@@ -21,9 +21,9 @@ pub fn check_jump(
     to: &RigidState,
 ) -> Result<(), Rejected> {
     let moved = (to.position - from.position).norm();
-    Limits::jump("position", moved, dt, limits.max_speed)?;
+    limits.moved("position", moved, dt)?;
     let turned = from.orientation.angle_to(&to.orientation);
-    Limits::jump("orientation", turned, dt, limits.max_rotation_rate)?;
+    limits.turned("orientation", turned, dt)?;
     Ok(())
 }
 

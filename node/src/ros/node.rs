@@ -247,6 +247,34 @@ struct Counters {
     resolution: String,
     /// The frame conventions' plausibility check: empty until it has decided, `ok`, or its warning.
     input_check: String,
+    /// Motion samples of the last [`RECENT_S`] (wall time taken, accepted).
+    recent: std::collections::VecDeque<(f64, bool)>,
+}
+
+/// The window over which a node that rejects most of its motion samples says so, s.
+const RECENT_S: f64 = 2.0;
+
+impl Counters {
+    /// Notes a motion sample taken at wall time `w`, accepted or not.
+    fn note_motion(&mut self, w: f64, accepted: bool) {
+        self.recent.push_back((w, accepted));
+        while self.recent.front().is_some_and(|(t, _)| *t < w - RECENT_S) {
+            self.recent.pop_front();
+        }
+    }
+
+    /// The diagnostics' state when most of the last [`RECENT_S`]' motion samples (at least five) were
+    /// rejected: the tank then follows the few accepted ones, which a consumer must not take for running.
+    fn mostly_rejected(&self, now: f64) -> Option<String> {
+        let recent = self.recent.iter().filter(|(t, _)| *t >= now - RECENT_S);
+        let (n, bad) = recent.fold((0, 0), |(n, b), (_, ok)| (n + 1, b + usize::from(!ok)));
+        (n >= 5 && 2 * bad > n).then(|| {
+            format!(
+                "running, but {bad} of the last {n} motion samples were rejected (last: {})",
+                self.last_reject
+            )
+        })
+    }
 }
 
 enum Input {
@@ -405,20 +433,6 @@ pub fn run(
     let mut params = cfg.sim_params()?;
     let names = Names::new(ros, DEFAULT_NAME)?;
     let c = &cfg.config;
-    let auto = &c.realtime.auto_resolution;
-    let resolution = if auto.enabled && c.realtime.mode == RealtimeMode::Realtime {
-        eprintln!(
-            "[{}] realtime.auto_resolution: timing {} s trials of {} ...",
-            names.node, auto.trial_s, cfg.source_name
-        );
-        let choice = crate::resolution::choose(&cfg, auto)?;
-        params.particle_spacing = choice.particle_spacing;
-        choice.describe()
-    } else if auto.enabled {
-        "off (only in realtime mode)".to_string()
-    } else {
-        "off".to_string()
-    };
     if !(c.motion_timeout_s.is_finite() && c.motion_timeout_s > 0.0) {
         anyhow::bail!(
             "{}: motion_timeout_s: must be a positive number of seconds, got {}",
@@ -447,7 +461,49 @@ pub fn run(
             c.particles.rate_hz
         );
     }
+    // Before the resolution trials, so that a signal during them stops the node cleanly too.
     let stop = super::shutdown_flag()?;
+    let auto = &c.realtime.auto_resolution;
+    let mut recorded_parameters = cfg.parameters.clone();
+    let mut choice_record = None;
+    let resolution = if auto.enabled && c.realtime.mode == RealtimeMode::Realtime {
+        auto.check(&cfg)?;
+        if c.solver.scheme == sph::params::Scheme::Wcsph {
+            eprintln!(
+                "[{}] realtime.auto_resolution with solver.scheme: wcsph: the weakly-compressible scheme's steps follow the speed of sound, so only very coarse spacings keep real time; solver.scheme: dfsph is the scheme for real time",
+                names.node
+            );
+        }
+        eprintln!(
+            "[{}] realtime.auto_resolution: timing {} s trials of {} (target real-time factor {}) ...",
+            names.node, auto.trial_s, cfg.source_name, auto.target_factor
+        );
+        let Some(choice) = crate::resolution::choose(&cfg, auto, &stop)? else {
+            eprintln!(
+                "[{}] interrupted during the resolution trials: stopping (nothing was published or recorded)",
+                names.node
+            );
+            return Ok(());
+        };
+        if let Some((dp, why)) = choice.skipped.last() {
+            eprintln!(
+                "[{}] realtime.auto_resolution: spacings of {dp:.4} m and coarser left out: {why}",
+                names.node
+            );
+        }
+        params.particle_spacing = choice.particle_spacing;
+        // The recording documents the spacing run, and how it was chosen.
+        recorded_parameters["particle_spacing"] = serde_json::json!(choice.particle_spacing);
+        choice_record = Some(serde_json::json!({
+            "requested_particle_spacing": c.particle_spacing,
+            "chosen": choice,
+        }));
+        choice.describe()
+    } else if auto.enabled {
+        "off (only in realtime mode)".to_string()
+    } else {
+        "off".to_string()
+    };
     let context = super::context()?;
     let mut node = context
         .new_node(
@@ -640,7 +696,11 @@ pub fn run(
     let mut recorder = if c.record.path.is_empty() {
         None
     } else {
-        Some(Recorder::create(&c.record, &cfg.parameters)?)
+        let mut meta = crate::record::parameters_metadata(&recorded_parameters);
+        if let Some(v) = &choice_record {
+            meta.insert("auto_resolution".into(), v.to_string());
+        }
+        Some(Recorder::create_with_metadata(&c.record, meta)?)
     };
     let counts = sim.counts();
     let full_name = names.node_fqn();
@@ -878,6 +938,7 @@ pub fn run(
                     other_base.clear();
                     last_real = ts - base;
                     counters.accepted += 1;
+                    counters.note_motion(w, true);
                     pacing.input(sample.received);
                     got = true;
                     if holding {
@@ -910,6 +971,7 @@ pub fn run(
                 }
                 Err(e) => {
                     counters.rejected += 1;
+                    counters.note_motion(w, false);
                     counters.last_reject = e.clone();
                     if w - last_warn > 1.0 {
                         last_warn = w;
@@ -1248,6 +1310,7 @@ pub fn run(
                 );
             }
         }
+        let rejecting = counters.mostly_rejected(wall());
         let state = if paused {
             "paused (~/pause)"
         } else if holding {
@@ -1257,7 +1320,7 @@ pub fn run(
         } else if sub_clock.is_some() && ros_time.is_none() {
             "waiting for /clock (follow_clock)"
         } else {
-            "running"
+            rejecting.as_deref().unwrap_or("running")
         };
         let w = wall();
         maybe_diagnostics(
@@ -1372,7 +1435,7 @@ fn diagnostics(
     let (counts, stats) = (sim.counts(), sim.stats());
     let level = if state == "running" && !c.input_check.starts_with("input check") {
         DiagnosticStatus::OK
-    } else if state == "running"
+    } else if state.starts_with("running")
         || stamp.is_none()
         || state.starts_with("behind")
         || state.starts_with("paused")
@@ -1441,7 +1504,34 @@ fn diagnostics(
 
 #[cfg(test)]
 mod tests {
-    use super::Reminder;
+    use super::{Counters, Reminder};
+
+    #[test]
+    fn a_node_rejecting_most_of_its_motion_says_so() {
+        let mut c = Counters::default();
+        // A few samples, or mostly accepted ones: running.
+        for k in 0..4 {
+            c.note_motion(k as f64 * 0.02, false);
+        }
+        assert_eq!(c.mostly_rejected(0.1), None);
+        for k in 4..10 {
+            c.note_motion(k as f64 * 0.02, true);
+        }
+        assert_eq!(c.mostly_rejected(0.2), None);
+        // 11 of the last 20 rejected.
+        c.last_reject = "pitch jumps".into();
+        for k in 10..21 {
+            c.note_motion(k as f64 * 0.02, false);
+        }
+        let s = c.mostly_rejected(0.42).unwrap();
+        assert!(
+            s.starts_with("running, but 15 of the last 21 motion samples were rejected")
+                && s.ends_with("(last: pitch jumps)"),
+            "{s}"
+        );
+        // Samples older than the window no longer count.
+        assert_eq!(c.mostly_rejected(3.0), None);
+    }
 
     #[test]
     fn a_reminder_comes_first_after_its_delay_then_every_ten_seconds() {
