@@ -349,7 +349,12 @@ fn run_loop(
         if stop.load(std::sync::atomic::Ordering::Relaxed) {
             return Err(LoopError::Interrupted(t));
         }
-        sim.step(motion).map_err(LoopError::Solver)?;
+        // Steps land on the next output time and on the end: outputs come at exactly k / rate (the
+        // incompressible scheme's steps are milliseconds long). Not on snapshot times: frames change nothing
+        // the run computes (they are the first state at or after their times, which is theirs exactly where
+        // their rate divides the output rate).
+        sim.step_to(motion, (k as f64 / rate).min(duration))
+            .map_err(LoopError::Solver)?;
         if let Some(speed) = pace.speed {
             let ahead = sim.time() / speed - start.elapsed().as_secs_f64();
             if ahead > 1e-3 {

@@ -282,6 +282,16 @@ fn the_incompressible_scheme_runs_and_reports_its_pressure_solver() {
     assert!(ps["iterations_per_step"].as_f64().unwrap() >= 2.0);
     // Steps follow the flow speed: far fewer than the weakly-compressible scheme's ~4,000 a second here.
     assert!(s["steps"].as_u64().unwrap() < 1000, "{s}");
+    // ... and land on the output times (50 Hz, steps of up to 5 ms): rows at exactly k / 50 s.
+    let rows = csv(&out.join("wrench.csv")).1;
+    assert_eq!(rows.len(), 51);
+    for (k, r) in rows.iter().enumerate() {
+        assert!(
+            (r[0] - k as f64 / 50.0).abs() < 1e-9,
+            "row {k} at {} s",
+            r[0]
+        );
+    }
     // The scheme's walls are particle layers: the mirror boundary is refused by name.
     let o = slosh()
         .args(["run", "seed_tank_019", "--out"])

@@ -249,7 +249,15 @@ fn compare_with_run_on(kind: &str, domain_id: u16, ranks: usize) {
         got_p.len()
     );
     assert_eq!(got_p[0].2, ["left", "mid"]);
-    // Compare at equal times (both observe at the first step at or after k / 20 s).
+    // The steps land on the output times: every output is stamped at k / 20 s (to the stamp's nanosecond and
+    // the subtraction of T0).
+    for (t, _) in &got_w {
+        assert!(
+            (t * 20.0 - (t * 20.0).round()).abs() < 1e-6,
+            "output at {t} s"
+        );
+    }
+    // Compare at equal times (both observe at k / 20 s).
     let peak_fx = run_w.iter().map(|r| r[1].abs()).fold(0.0, f64::max);
     assert!(
         peak_fx > 1.0,

@@ -85,6 +85,8 @@ pub struct Simulation<const D: usize, K: Kernel> {
     /// last observation, and their duration (the observed wrench is their mean).
     impulse: PassTotals,
     impulse_time: f64,
+    /// A time the current step must not pass ([`Simulation::step_to`]; ∞ otherwise).
+    step_limit: f64,
     /// This rank's part of a decomposition over several processes (MPI), if any.
     dom: Option<Domain>,
     /// Floating bodies (their particles are among `bound`).
@@ -284,6 +286,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             dwork: Default::default(),
             impulse: PassTotals::default(),
             impulse_time: 0.0,
+            step_limit: f64::INFINITY,
             dom,
             bodies,
         };
@@ -425,14 +428,15 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         }
     }
 
-    /// When the motion ends (across ranks: rank 0's motion's end).
+    /// When the motion ends, or the step must end ([`Simulation::step_to`]) if sooner (across ranks: rank
+    /// 0's).
     fn end_time(&self, motion: &dyn TankMotion) -> f64 {
         match &self.dom {
-            None => motion.end_time(),
+            None => motion.end_time().min(self.step_limit),
             Some(dom) => {
                 let mut buf = Vec::new();
                 if dom.is_root() {
-                    buf.push(motion.end_time());
+                    buf.push(motion.end_time().min(self.step_limit));
                 }
                 dom.comm.broadcast(&mut buf);
                 buf[0]
@@ -722,6 +726,19 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         // incompressible scheme) then fork and join among the pool's own threads, instead of each waking the
         // pool from outside and putting the calling thread to sleep until it is done.
         rayon::scope(|_| self.step_here(motion))
+    }
+
+    /// Advances one time step, cut short where it would pass `limit`, so that it lands on it (an output
+    /// time: outputs then come at exactly their times, whatever the step). A limit closer than twice the
+    /// shortest allowed step is not worth a step of its own: the step then runs whole. With several ranks,
+    /// rank 0's limit holds.
+    pub fn step_to(&mut self, motion: &dyn TankMotion, limit: f64) -> Result<f64, SimError> {
+        if limit - self.time > 2.0 * self.dt_min {
+            self.step_limit = limit;
+        }
+        let r = self.step(motion);
+        self.step_limit = f64::INFINITY;
+        r
     }
 
     fn step_here(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
@@ -1271,6 +1288,8 @@ fn rest_density<const D: usize, K: Kernel>(
 /// A simulation of any dimension and kernel, chosen at run time.
 pub trait Solver: Send {
     fn step(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError>;
+    /// One step that does not pass `limit` (see [`Simulation::step_to`]).
+    fn step_to(&mut self, motion: &dyn TankMotion, limit: f64) -> Result<f64, SimError>;
     fn advance_to(&mut self, motion: &dyn TankMotion, t_end: f64) -> Result<(), SimError>;
     fn observe(&mut self, motion: &dyn TankMotion) -> Result<Observation, SimError>;
     fn time(&self) -> f64;
@@ -1291,6 +1310,9 @@ pub trait Solver: Send {
 impl<const D: usize, K: Kernel> Solver for Simulation<D, K> {
     fn step(&mut self, motion: &dyn TankMotion) -> Result<f64, SimError> {
         Simulation::step(self, motion)
+    }
+    fn step_to(&mut self, motion: &dyn TankMotion, limit: f64) -> Result<f64, SimError> {
+        Simulation::step_to(self, motion, limit)
     }
     fn advance_to(&mut self, motion: &dyn TankMotion, t_end: f64) -> Result<(), SimError> {
         Simulation::advance_to(self, motion, t_end)

@@ -37,7 +37,9 @@ pub fn run(
     let start_stamp = opts.start_stamp();
     let n = (opts.duration * opts.rate_hz).round() as u64;
     eprintln!(
-        "slosh motion: publishing {n} samples at {} Hz on iceoryx2 {service}/motion",
+        "slosh motion: publishing {} samples (t = 0 to {} s) at {} Hz on iceoryx2 {service}/motion",
+        n + 1,
+        n as f64 / opts.rate_hz,
         opts.rate_hz
     );
     let start = Instant::now();

@@ -237,7 +237,9 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
     let mut clock_t = f64::NEG_INFINITY;
     let start = Instant::now();
     eprintln!(
-        "slosh motion: publishing {n} samples at {} Hz on {odom_topic}{}",
+        "slosh motion: publishing {} samples (t = 0 to {} s) at {} Hz on {odom_topic}{}",
+        n + 1,
+        n as f64 / opts.rate_hz,
         opts.rate_hz,
         if opts.lockstep {
             " in lockstep with /clock"

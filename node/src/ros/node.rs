@@ -739,6 +739,7 @@ pub fn run(
     };
     let mut t0: Option<f64> = None;
     let rate = c.output_rate_hz;
+    // Outputs at k / rate (the steps land on them), the first the state at t = 0 before any step.
     let mut next_output = 0u64;
     let mut last_diag = f64::NEG_INFINITY;
     let mut last_warn = f64::NEG_INFINITY;
@@ -1191,20 +1192,26 @@ pub fn run(
             if let Some(d) = opts.duration {
                 limit = limit.min(d + dt_cap);
             }
-            while sim.time() + dt_cap < limit && !stop.load(Ordering::Relaxed) {
-                if let Err(e) = sim.step(&motion) {
-                    error = Some(e.to_string());
-                    break;
-                }
-                stepped = true;
-                let g = motion.state(sim.time()).apparent_gravity(params.gravity);
-                match gravity_check.add(sim.time(), g, params.gravity, input_kind) {
-                    Some(Ok(())) => counters.input_check = "ok".into(),
-                    Some(Err(w)) => {
-                        log(ros2_client::ros2::LogLevel::Warn, &w);
-                        counters.input_check = w;
+            // The first pass at t = 0 takes no step: it only publishes the initial state (output 0).
+            let mut initial = next_output == 0 && sim.time() == 0.0;
+            while (initial || sim.time() + dt_cap < limit) && !stop.load(Ordering::Relaxed) {
+                if !std::mem::take(&mut initial) {
+                    // Each step lands on the next output time (when the input reaches that far), so
+                    // outputs are stamped on the output rate's grid whatever the step.
+                    if let Err(e) = sim.step_to(&motion, next_output as f64 / rate) {
+                        error = Some(e.to_string());
+                        break;
                     }
-                    None => {}
+                    stepped = true;
+                    let g = motion.state(sim.time()).apparent_gravity(params.gravity);
+                    match gravity_check.add(sim.time(), g, params.gravity, input_kind) {
+                        Some(Ok(())) => counters.input_check = "ok".into(),
+                        Some(Err(w)) => {
+                            log(ros2_client::ros2::LogLevel::Warn, &w);
+                            counters.input_check = w;
+                        }
+                        None => {}
+                    }
                 }
                 // Fetch input between steps so that the reader's short history (keep last 5) never
                 // overflows while a long stretch is stepped.

@@ -95,6 +95,11 @@ impl Solver for Distributed {
         self.call(Call::Step, &[]);
         self.local.step(motion)
     }
+    fn step_to(&mut self, motion: &dyn TankMotion, limit: f64) -> Result<f64, SimError> {
+        // The other ranks take rank 0's limit with its motion's end (broadcast within the step).
+        self.call(Call::Step, &[]);
+        self.local.step_to(motion, limit)
+    }
     fn advance_to(&mut self, motion: &dyn TankMotion, t_end: f64) -> Result<(), SimError> {
         self.call(Call::AdvanceTo, &[t_end]);
         self.local.advance_to(motion, t_end)
