@@ -423,7 +423,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let s =
                 visuals.plot_after(&out, runner::run(&loaded, &out, &opts).map_err(Into::into))?;
             println!(
-                "done: {} s simulated in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s, {} liquid + {} boundary particles, {} lost)",
+                "done: {:.3} s simulated in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s, {} liquid + {} boundary particles, {} lost)",
                 s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s, s.particles_fluid, s.particles_boundary, s.particles_lost
             );
             println!("outputs: {}", outputs(&out));
@@ -463,7 +463,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 }
             }).map_err(Into::into))?;
             println!(
-                "done: {} s replayed in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s)",
+                "done: {:.3} s replayed in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s)",
                 s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s
             );
             println!("outputs: {}", outputs(&out));

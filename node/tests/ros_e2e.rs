@@ -712,10 +712,13 @@ fn ros_domain_id_takes_effect() {
     let (_c1, _n1, right) = listen(41);
     let (_c2, _n2, wrong) = listen(42);
     let log = dir.join("node.log");
-    let _node_proc = Kill(
+    let bag = dir.join("bag");
+    let mut node_proc = Kill(
         slosh()
             .args(["node", "--ros-args", "--params-file"])
             .arg(&case)
+            .arg("-p")
+            .arg(format!("record.path:={}", bag.display()))
             .env("ROS_DOMAIN_ID", "41")
             .stderr(std::fs::File::create(&log).unwrap())
             .spawn()
@@ -743,6 +746,15 @@ fn ros_domain_id_takes_effect() {
         said.contains("no motion sample yet after 5 s on /motion/odom: is the publisher running"),
         "{said}"
     );
+    // Stopped so, it says that its bag holds no simulation (and the bag is whole).
+    stop_logged_in(&mut node_proc.0);
+    let said = std::fs::read_to_string(&log).unwrap();
+    assert!(
+        said.contains("no motion sample was accepted: the bag")
+            && said.contains("holds no simulation"),
+        "{said}"
+    );
+    assert!(bag.join("metadata.yaml").exists());
     let out = slosh()
         .args(["node", "seed_tank_039"])
         .env("ROS_DOMAIN_ID", "ship")

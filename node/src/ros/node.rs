@@ -1376,6 +1376,12 @@ pub fn run(
         )
     });
     if let Some(mut r) = recorder.take() {
+        if counters.accepted == 0 {
+            eprintln!(
+                "[{full_name}] no motion sample was accepted: the bag {} holds no simulation",
+                c.record.path
+            );
+        }
         for s in other_base.drain(..) {
             s.record_refused(&mut r)?;
         }
