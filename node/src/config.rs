@@ -720,7 +720,7 @@ fn finish(
     }
     let mut config: RunConfig = serde_path_to_error::deserialize(params.clone()).map_err(|e| {
         let key = e.path().to_string();
-        let path = key.clone();
+        let message = plain_type_error(&e.into_inner().to_string(), &key);
         // An error in a parameter an override set (or in a group it set) is the override's.
         let given = keys.iter().any(|k| {
             *k == key || key.starts_with(&format!("{k}.")) || k.starts_with(&format!("{key}."))
@@ -732,7 +732,7 @@ fn finish(
             } else {
                 key
             },
-            message: plain_type_error(&e.into_inner().to_string(), &path),
+            message,
         }
     })?;
     if config.use_sim_time && config.realtime.mode == RealtimeMode::Realtime {

@@ -1531,7 +1531,7 @@ mod tests {
             c.note_motion(k as f64 * 0.02, true);
         }
         assert_eq!(c.mostly_rejected(0.2), None);
-        // 11 of the last 20 rejected.
+        // 15 of the last 21 rejected.
         c.last_reject = "pitch jumps".into();
         for k in 10..21 {
             c.note_motion(k as f64 * 0.02, false);
