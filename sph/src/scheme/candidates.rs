@@ -16,8 +16,8 @@ pub fn lane_sum(l: &[f32; LANES]) -> f32 {
     l.iter().sum()
 }
 
-/// Whether this CPU runs the pair loops with 256-bit lanes, fused multiply-add and popcnt (checked once, cached by
-/// std).
+/// Whether this CPU runs the pair loops with 256-bit lanes, fused multiply-add, popcnt and F16C (half
+/// precision conversions; every CPU with AVX2 has it) (checked once, cached by std).
 #[inline]
 pub fn wide_lanes() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -25,6 +25,7 @@ pub fn wide_lanes() -> bool {
         std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("fma")
             && std::arch::is_x86_feature_detected!("popcnt")
+            && std::arch::is_x86_feature_detected!("f16c")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {

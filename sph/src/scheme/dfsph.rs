@@ -30,8 +30,9 @@
 //! results do not depend on the number of threads.
 
 use super::candidates::{lane_sum, share_room, wide_lanes, Room, LANES};
+use super::half::Half4;
 use super::near::Near;
-use super::pair_sums::{divergence, push};
+use super::pair_sums::Grad;
 use super::warm_start::{Columns, Setting};
 use super::{FrameTerms, PassTotals, Ranks, CHUNK};
 use crate::domain::Op;
@@ -81,11 +82,11 @@ struct Lists<const D: usize> {
     /// Offsets into `j`/`g` per particle of the chunk (len + 1).
     start: Vec<u32>,
     j: Vec<u32>,
-    /// ∇_a W_ab in 2D; in 3D `g4` holds them instead, padded to four lanes (the last 0): on x86_64 the
-    /// pressure iterations load a pair's gradient (and the neighbour's velocity, `Workspace::vel4`) in one
-    /// 16-byte load each.
+    /// ∇_a W_ab in 2D; in 3D `gh` holds them instead, times h⁴ in half precision (`half`), four lanes
+    /// (the last 0): 8 bytes a pair, two pairs' in one 16-byte load and one conversion (the neighbour's
+    /// velocity is one 16-byte load too, `Workspace::vel4`).
     g: Vec<[f32; D]>,
-    g4: Vec<[f32; 4]>,
+    gh: Vec<Half4>,
     /// One past the largest index in `j` (0 if none): the passes check it once against the arrays they
     /// read the neighbours from, then read them unchecked.
     end_j: usize,
@@ -227,14 +228,14 @@ struct Around<'a, const D: usize> {
 /// Branch-free over blocks of [`LANES`]: padding beyond the support adds nothing.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn hood<const D: usize, const W: usize, K: Kernel>(
+fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
     k: &K,
     c: &Coefficients,
     (xa, va): ([f32; D], [f32; D]),
     around: Around<'_, D>,
     (fs, bs): (&mut Near<D>, &mut Near<D>),
     j: &mut Vec<u32>,
-    g: &mut Vec<[f32; W]>,
+    g: &mut Vec<R>,
     wide: bool,
 ) -> Hood<D> {
     fs.select(xa, c.pair.support2, around.liquid, around.fluid, wide);
@@ -250,7 +251,9 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
         wflux: z,
         walls: z,
     };
-    let first = j.len();
+    let (first, first_g) = (j.len(), g.len());
+    // What the records hold: ∇W times this.
+    let scale = R::scale(c.pair.h);
     // Every lane is written after the end of the list and kept only if it is a neighbour (no branches on
     // whether it is).
     // Room for every selected lane, padding included.
@@ -294,14 +297,16 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
             hit[l] = inside && r2 > 0.0;
         }
         #[cfg(target_arch = "x86_64")]
-        if wide && D == 3 && W == 4 {
+        if wide && D == 3 && R::AVX_BLOCKS {
             let mask = (0..LANES).fold(0usize, |m, l| m | (hit[l] as usize) << l);
-            // SAFETY: `wide` holds only where the CPU has AVX2; n + LANES ≤ (blk + 1) · LANES ≤ the room
-            // reserved above (n ≤ blk · LANES); D == 3 and W == 4.
+            // SAFETY: `wide` holds only where the CPU has AVX2 and F16C; n + LANES ≤ (blk + 1) · LANES ≤
+            // the room reserved above (n ≤ blk · LANES); D == 3, and records of `AVX_BLOCKS` types are
+            // `Half4`s.
             unsafe {
                 store_block_avx2(
                     mask,
                     [&gl[0], &gl[1], &gl[2 % D]],
+                    scale,
                     &idx,
                     js.as_mut_ptr().add(n).cast(),
                     gs.as_mut_ptr().add(n).cast(),
@@ -312,14 +317,14 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
         }
         for l in 0..LANES {
             js[n].write(idx[l]);
-            gs[n].write(std::array::from_fn(|d| if d < D { gl[d][l] } else { 0.0 }));
+            gs[n].write(R::pack(std::array::from_fn(|d| gl[d][l] * scale)));
             n += hit[l] as usize;
         }
     }
     // SAFETY: the first n entries of the spare capacity were written above.
     unsafe {
         j.set_len(first + n);
-        g.set_len(first + n);
+        g.set_len(first_g + n);
     }
     for blk in 0..bs.blocks() {
         let (dxs, ws, _) = bs.block(blk);
@@ -365,31 +370,35 @@ fn hood<const D: usize, const W: usize, K: Kernel>(
 }
 
 /// The lanes of one block of 3D neighbours set in `mask`, packed to the front (one lane permutation,
-/// `near::PACK`), as eight four-lane gradient records (x, y, z, 0) and eight indices, stored whole at `j`
-/// and `g` (what lies beyond the kept lanes is overwritten by the next block or cut off): the same values
-/// in the same order as `hood`'s lane-by-lane writes, in ~25 instructions instead of ~110.
+/// `near::PACK`), as eight [`Half4`] records of the gradients times `scale` (x, y, z, 0) and eight
+/// indices, stored whole at `j` and `g` (what lies beyond the kept lanes is overwritten by the next block
+/// or cut off): the same bits in the same order as `hood`'s lane-by-lane writes (F16C rounds as
+/// `half::to_half`), in ~30 instructions instead of ~150.
 ///
 /// # Safety
-/// The CPU has AVX2; `j` has room for 8 u32 and `g` for 32 f32.
+/// The CPU has AVX2 and F16C; `j` has room for 8 u32 and `g` for 32 u16.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn store_block_avx2(
     mask: usize,
     gl: [&[f32; LANES]; 3],
+    scale: f32,
     idx: &[u32; LANES],
     j: *mut u32,
-    g: *mut f32,
+    g: *mut u16,
 ) {
     use std::arch::x86_64::*;
     const { assert!(LANES == 8, "one 256-bit register of f32 lanes") };
-    // SAFETY: AVX2 (the caller); the loads read whole arrays of 8 lanes, the stores stay within the room
-    // the caller guarantees; the table is 32-byte aligned.
+    // SAFETY: AVX2 and F16C (the caller); the loads read whole arrays of 8 lanes, the stores stay within
+    // the room the caller guarantees; the table is 32-byte aligned.
     unsafe {
         let perm = _mm256_load_si256(super::near::PACK.0[mask].as_ptr() as *const __m256i);
+        let s = _mm256_set1_ps(scale);
         // (No closures here: a closure would not inherit AVX2, and the intrinsics would not be inlined.)
-        let x = _mm256_permutevar8x32_ps(_mm256_loadu_ps(gl[0].as_ptr()), perm);
-        let y = _mm256_permutevar8x32_ps(_mm256_loadu_ps(gl[1].as_ptr()), perm);
-        let z = _mm256_permutevar8x32_ps(_mm256_loadu_ps(gl[2].as_ptr()), perm);
+        let lane = |d: usize| _mm256_mul_ps(_mm256_loadu_ps(gl[d].as_ptr()), s);
+        let x = _mm256_permutevar8x32_ps(lane(0), perm);
+        let y = _mm256_permutevar8x32_ps(lane(1), perm);
+        let z = _mm256_permutevar8x32_ps(lane(2), perm);
         let zero = _mm256_setzero_ps();
         // Per 128-bit half: (x0 y0 x1 y1), (x2 y2 x3 y3), (z0 0 z1 0), (z2 0 z3 0) …
         let (t0, t1) = (_mm256_unpacklo_ps(x, y), _mm256_unpackhi_ps(x, y));
@@ -399,26 +408,30 @@ unsafe fn store_block_avx2(
         let r1 = _mm256_shuffle_ps::<0xEE>(t0, t2);
         let r2 = _mm256_shuffle_ps::<0x44>(t1, t3);
         let r3 = _mm256_shuffle_ps::<0xEE>(t1, t3);
-        _mm256_storeu_ps(g, _mm256_permute2f128_ps::<0x20>(r0, r1));
-        _mm256_storeu_ps(g.add(8), _mm256_permute2f128_ps::<0x20>(r2, r3));
-        _mm256_storeu_ps(g.add(16), _mm256_permute2f128_ps::<0x31>(r0, r1));
-        _mm256_storeu_ps(g.add(24), _mm256_permute2f128_ps::<0x31>(r2, r3));
+        // Two records (8 binary16) per store.
+        const NEAREST: i32 = _MM_FROUND_TO_NEAREST_INT;
+        let half = |r: __m256| _mm256_cvtps_ph::<NEAREST>(r);
+        let st = |at: usize, r: __m256| _mm_storeu_si128(g.add(at) as *mut __m128i, half(r));
+        st(0, _mm256_permute2f128_ps::<0x20>(r0, r1));
+        st(8, _mm256_permute2f128_ps::<0x20>(r2, r3));
+        st(16, _mm256_permute2f128_ps::<0x31>(r0, r1));
+        st(24, _mm256_permute2f128_ps::<0x31>(r2, r3));
         let i = _mm256_loadu_si256(idx.as_ptr() as *const __m256i);
         _mm256_storeu_si256(j as *mut __m256i, _mm256_permutevar8x32_epi32(i, perm));
     }
 }
 
-/// [`hood`] compiled for AVX2 + FMA (and popcnt): the same source, its lane loops vectorised 8 wide.
+/// [`hood`] compiled for AVX2 + FMA (popcnt, F16C): the same source, its lane loops vectorised 8 wide.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,popcnt")]
-fn hood_avx2<const D: usize, const W: usize, K: Kernel>(
+#[target_feature(enable = "avx2,fma,popcnt,f16c")]
+fn hood_avx2<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
     k: &K,
     c: &Coefficients,
     own: ([f32; D], [f32; D]),
     around: Around<'_, D>,
     near: (&mut Near<D>, &mut Near<D>),
     j: &mut Vec<u32>,
-    g: &mut Vec<[f32; W]>,
+    g: &mut Vec<R>,
 ) -> Hood<D> {
     hood(k, c, own, around, near, j, g, true)
 }
@@ -438,7 +451,7 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.start.clear();
     lists.j.clear();
     lists.g.clear();
-    lists.g4.clear();
+    lists.gh.clear();
     // Until the lists are whole again (a build cut short leaves no bound the passes would trust).
     lists.end_j = usize::MAX;
     lists.gb.clear();
@@ -480,17 +493,19 @@ fn build_chunk<const D: usize, K: Kernel>(
             bound: (&b.x, &b.v),
         };
         let near = (&mut *fs, &mut *bs);
-        let (j, g, g4) = (&mut lists.j, &mut lists.g, &mut lists.g4);
+        let (j, g, gh) = (&mut lists.j, &mut lists.g, &mut lists.gh);
         let hd = match (p.wide, D == 3) {
-            // SAFETY: `wide` is true only where the CPU reports AVX2, FMA and popcnt.
+            // SAFETY: `wide` is true only where the CPU reports AVX2, FMA, popcnt and F16C.
             #[cfg(target_arch = "x86_64")]
-            (true, true) => unsafe { hood_avx2(p.k, c, own, around, near, j, g4) },
+            (true, true) => unsafe {
+                hood_avx2::<D, 4, Half4, K>(p.k, c, own, around, near, j, gh)
+            },
             #[cfg(target_arch = "x86_64")]
-            (true, false) => unsafe { hood_avx2(p.k, c, own, around, near, j, g) },
+            (true, false) => unsafe { hood_avx2::<D, D, _, K>(p.k, c, own, around, near, j, g) },
             #[cfg(not(target_arch = "x86_64"))]
             (true, _) => unreachable!("wide lanes are x86_64 only"),
-            (false, true) => hood(p.k, c, own, around, near, j, g4, false),
-            (false, false) => hood(p.k, c, own, around, near, j, g, false),
+            (false, true) => hood::<D, 4, Half4, K>(p.k, c, own, around, near, j, gh, false),
+            (false, false) => hood::<D, D, _, K>(p.k, c, own, around, near, j, g, false),
         };
         let (grad, grad_b) = (hd.grad, hd.grad_b);
         // The particle's own k changes its density through (Σ_f m∇W + Σ_b m∇W)·(Σ_f m∇W + 2 Σ_b m∇W): the
@@ -551,12 +566,12 @@ enum Mode {
 /// (density units).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn error_chunk<const D: usize, const W: usize>(
+fn error_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
     wide: bool,
     c: &Coefficients,
     mode: Mode,
     dt: f32,
-    (lists, g): (&Lists<D>, &[[f32; W]]),
+    (lists, g): (&Lists<D>, &[R]),
     vel: &[[f32; W]],
     first: usize,
     (rho, factor): (&[f32], &[f32]),
@@ -564,6 +579,8 @@ fn error_chunk<const D: usize, const W: usize>(
 ) -> Partial {
     let mut err = 0u64;
     let (inv_dt, inv_dt2) = (1.0 / dt, 1.0 / (dt * dt));
+    // The records hold ∇W times the scale (1 for f32 records: then m exactly).
+    let m = c.pair.m_fluid / R::scale(c.pair.h);
     assert!(lists.end_j <= vel.len() && lists.start.len() == k.len() + 1);
     for o in 0..k.len() {
         let a = first + o;
@@ -571,11 +588,10 @@ fn error_chunk<const D: usize, const W: usize>(
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
         // SAFETY: every index in the lists is below `end_j` (asserted above); `wide` (from `wide_lanes()`)
         // only where the CPU has AVX2, so AVX.
-        let mut s = c.pair.m_fluid
-            * unsafe { divergence(&lists.j[lo..hi], &g[lo..hi], vel, va, wide) }
-                .iter()
-                .take(D)
-                .sum::<f32>();
+        let mut s = m * unsafe { R::divergence(&lists.j[lo..hi], &g[lo..hi], vel, va, wide) }
+            .iter()
+            .take(D)
+            .sum::<f32>();
         let gb = lists.gb[o];
         for d in 0..D {
             s += va[d] * gb[d];
@@ -607,11 +623,11 @@ fn error_chunk<const D: usize, const W: usize>(
 /// written padded to four lanes into `vel4` unless that is empty.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn update_chunk<const D: usize, const W: usize>(
+fn update_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
     wide: bool,
     c: &Coefficients,
     dt: f32,
-    (lists, g): (&Lists<D>, &[[f32; W]]),
+    (lists, g): (&Lists<D>, &[R]),
     kall: &[f32],
     first: usize,
     vel: &mut [[f32; D]],
@@ -619,6 +635,7 @@ fn update_chunk<const D: usize, const W: usize>(
     vel4: &mut [[f32; 4]],
 ) {
     assert!(lists.end_j <= kall.len() && lists.start.len() == vel.len() + 1);
+    let m = c.pair.m_fluid / R::scale(c.pair.h);
     assert!(vel4.is_empty() || vel4.len() == vel.len());
     for o in 0..vel.len() {
         let a = first + o;
@@ -627,10 +644,10 @@ fn update_chunk<const D: usize, const W: usize>(
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
         // SAFETY: every index in the lists is below `end_j` (asserted above); `wide` only with AVX, as in
         // `error_chunk`.
-        let acc = unsafe { push(&lists.j[lo..hi], &g[lo..hi], kall, ka, wide) };
+        let acc = unsafe { R::push(&lists.j[lo..hi], &g[lo..hi], kall, ka, wide) };
         let gb = lists.gb[o];
         for d in 0..D {
-            vel[o][d] -= dt * (c.pair.m_fluid * acc[d] + MIRROR * ka * gb[d]);
+            vel[o][d] -= dt * (m * acc[d] + MIRROR * ka * gb[d]);
         }
         if let Some(p) = vel4.get_mut(o) {
             *p = std::array::from_fn(|d| if d < D { vel[o][d] } else { 0.0 });
@@ -644,11 +661,11 @@ fn update_chunk<const D: usize, const W: usize>(
 fn maybe_avx<R>(wide: bool, f: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
     if wide {
-        #[target_feature(enable = "avx")]
+        #[target_feature(enable = "avx,f16c")]
         fn avx<R>(f: impl FnOnce() -> R) -> R {
             f()
         }
-        // SAFETY: `wide` is true only where the CPU reports AVX2 (and so AVX).
+        // SAFETY: `wide` is true only where the CPU reports AVX2 (and so AVX) and F16C.
         return unsafe { avx(f) };
     }
     let _ = wide;
@@ -659,12 +676,12 @@ fn maybe_avx<R>(wide: bool, f: impl FnOnce() -> R) -> R {
 /// as `maybe_avx::avx` instantiated for this function's closure), with AVX where `wide`.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn error_pass<const D: usize, const W: usize>(
+fn error_pass<const D: usize, const W: usize, R: Grad<D, W>>(
     wide: bool,
     c: &Coefficients,
     mode: Mode,
     dt: f32,
-    lists: (&Lists<D>, &[[f32; W]]),
+    lists: (&Lists<D>, &[R]),
     vel: &[[f32; W]],
     first: usize,
     own: (&[f32], &[f32]),
@@ -678,11 +695,11 @@ fn error_pass<const D: usize, const W: usize>(
 /// [`update_chunk`] out of line and with AVX where `wide`, as [`error_pass`].
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn update_pass<const D: usize, const W: usize>(
+fn update_pass<const D: usize, const W: usize, R: Grad<D, W>>(
     wide: bool,
     c: &Coefficients,
     dt: f32,
-    lists: (&Lists<D>, &[[f32; W]]),
+    lists: (&Lists<D>, &[R]),
     kall: &[f32],
     first: usize,
     (vel, ksum, vel4): (&mut [[f32; D]], &mut [f32], &mut [[f32; 4]]),
@@ -769,7 +786,7 @@ impl<const D: usize> Workspace<D> {
                 let room = peak + peak / 4 + cands;
                 l.j.reserve_exact(room.saturating_sub(l.j.len()));
                 if D == 3 {
-                    l.g4.reserve_exact(room.saturating_sub(l.g4.len()));
+                    l.gh.reserve_exact(room.saturating_sub(l.gh.len()));
                 } else {
                     l.g.reserve_exact(room.saturating_sub(l.g.len()));
                 }
@@ -806,7 +823,7 @@ impl<const D: usize> Workspace<D> {
                 let r = ci * CHUNK..(ci * CHUNK + kc.len());
                 let own = (&rho[r.clone()], &factor[r]);
                 if D == 3 {
-                    error_pass(wide, c, mode, dt, (l, &l.g4), vel4, ci * CHUNK, own, kc)
+                    error_pass(wide, c, mode, dt, (l, &l.gh), vel4, ci * CHUNK, own, kc)
                 } else {
                     error_pass(wide, c, mode, dt, (l, &l.g), vel, ci * CHUNK, own, kc)
                 }
@@ -836,7 +853,7 @@ impl<const D: usize> Workspace<D> {
                 .zip(lists.par_iter())
                 .enumerate()
                 .for_each(|(ci, (((v, ks), v4), l))| {
-                    update_pass(wide, c, dt, (l, &l.g4), k, ci * CHUNK, (v, ks, v4))
+                    update_pass(wide, c, dt, (l, &l.gh), k, ci * CHUNK, (v, ks, v4))
                 });
         } else {
             vel.par_chunks_mut(CHUNK)
@@ -1241,16 +1258,18 @@ mod tests {
         )
     }
 
-    /// [`hood`] (AVX2 lanes where `wide`) with gradient slots of W lanes: its sums, its neighbour list and
-    /// the sum of the listed gradients (whose lanes beyond D must be 0).
-    fn listed<const D: usize, const W: usize, K: Kernel>(
+    /// [`hood`] (AVX2 lanes where `wide`) with gradient records R of W lanes: its sums, its neighbour
+    /// list, the sum of the listed gradients (whose lanes beyond D must be 0) and of their magnitudes
+    /// (unscaled), and the records' bits.
+    #[allow(clippy::type_complexity)]
+    fn listed<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
         k: &K,
         c: &Coefficients,
         own: ([f32; D], [f32; D]),
         around: Around<'_, D>,
         wide: bool,
-    ) -> (Hood<D>, Vec<u32>, [f64; D], Vec<u32>) {
-        let (mut j, mut g) = (Vec::new(), Vec::<[f32; W]>::new());
+    ) -> (Hood<D>, Vec<u32>, [(f64, f64); D], Vec<u32>) {
+        let (mut j, mut g) = (Vec::new(), Vec::<R>::new());
         let (mut fs, mut bs) = (Near::default(), Near::default());
         let near = (&mut fs, &mut bs);
         let s = if wide {
@@ -1265,8 +1284,15 @@ mod tests {
             hood(k, c, own, around, near, &mut j, &mut g, false)
         };
         assert_eq!(g.len(), j.len());
+        let g: Vec<[f32; W]> = g.into_iter().map(R::lanes).collect();
         assert!(g.iter().all(|g| g[D..].iter().all(|x| *x == 0.0)));
-        let sum = std::array::from_fn(|d| g.iter().map(|g| g[d] as f64).sum());
+        let scale = R::scale(c.pair.h) as f64;
+        let sum = std::array::from_fn(|d| {
+            let (s, a) = g.iter().fold((0.0, 0.0), |(s, a), g| {
+                (s + g[d] as f64, a + (g[d] as f64).abs())
+            });
+            (s / scale, a / scale)
+        });
         let bits = g.iter().flat_map(|g| g.map(f32::to_bits)).collect();
         (s, j, sum, bits)
     }
@@ -1346,19 +1372,26 @@ mod tests {
                 std::array::from_fn(|d| x[d][a]),
                 std::array::from_fn(|d| v[d][a]),
             );
-            // Plain and AVX2 lanes, gradients in D and in 4 lanes.
+            // Plain and AVX2 lanes, gradients in f32 (D lanes and 4) and in half precision (4 lanes).
             let mut fast = vec![
-                listed::<D, D, K>(&k, &c, own, around, false),
-                listed::<D, 4, K>(&k, &c, own, around, false),
+                listed::<D, D, [f32; D], K>(&k, &c, own, around, false),
+                listed::<D, 4, [f32; 4], K>(&k, &c, own, around, false),
+                listed::<D, 4, Half4, K>(&k, &c, own, around, false),
             ];
             if wide_lanes() {
-                fast.push(listed::<D, D, K>(&k, &c, own, around, true));
-                fast.push(listed::<D, 4, K>(&k, &c, own, around, true));
-                // The AVX2 lists (in 3D with four lanes written by `store_block_avx2`) hold the plain
+                fast.push(listed::<D, D, [f32; D], K>(&k, &c, own, around, true));
+                fast.push(listed::<D, 4, [f32; 4], K>(&k, &c, own, around, true));
+                fast.push(listed::<D, 4, Half4, K>(&k, &c, own, around, true));
+                // The AVX2 lists (in 3D the half records written by `store_block_avx2`) hold the plain
                 // lists' neighbours and gradients to the bit.
-                let (plain, wide) = (&fast[1], &fast[3]);
-                assert_eq!(plain.1, wide.1, "listed neighbours, plain and AVX2");
-                assert_eq!(plain.3, wide.3, "listed gradients, plain and AVX2");
+                for (plain, wide) in [
+                    (&fast[0], &fast[3]),
+                    (&fast[1], &fast[4]),
+                    (&fast[2], &fast[5]),
+                ] {
+                    assert_eq!(plain.1, wide.1, "listed neighbours, plain and AVX2");
+                    assert_eq!(plain.3, wide.3, "listed gradients, plain and AVX2");
+                }
             }
             let gs = grad
                 .iter()
@@ -1366,7 +1399,7 @@ mod tests {
                 .map(|q| q.abs())
                 .fold(1e-9, f64::max);
             let vs = visc.iter().map(|q| q.abs()).fold(1e-9, f64::max);
-            for (s, j, gsum, _) in &fast {
+            for (i, (s, j, gsum, _)) in fast.iter().enumerate() {
                 assert!(
                     (s.density as f64 - density).abs() < 1e-5 * density,
                     "density"
@@ -1403,7 +1436,18 @@ mod tests {
                 assert_eq!(j, &list, "liquid neighbours");
                 for d in 0..D {
                     let m = c.pair.m_fluid as f64;
-                    assert!((m * gsum[d] - grad[d]).abs() < 1e-4 * gs, "listed ∇W {d}");
+                    // Half records: each within 2⁻¹¹ of its f32 value (relatively; at the kernel's edge
+                    // 2⁻²⁵ h⁻⁴ absolutely).
+                    let half = if i % 3 == 2 {
+                        m * (gsum[d].1 / 2048.0
+                            + j.len() as f64 / 3.3554432e7 / (c.pair.h as f64).powi(4))
+                    } else {
+                        0.0
+                    };
+                    assert!(
+                        (m * gsum[d].0 - grad[d]).abs() < 1e-4 * gs + half,
+                        "listed ∇W {d}"
+                    );
                 }
                 assert_eq!(s.liquid as usize, list.len());
             }

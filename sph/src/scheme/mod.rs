@@ -3,6 +3,7 @@
 
 pub mod candidates;
 pub mod dfsph;
+pub mod half;
 pub mod near;
 pub mod pair_sums;
 pub mod warm_start;

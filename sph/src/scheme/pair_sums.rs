@@ -1,12 +1,15 @@
 //! The sums over a particle's neighbour list that the incompressible scheme's pressure iterations repeat:
-//! the divergence Σ_b (v_a − v_b)·∇W_ab and the pressure push Σ_b (k_a + k_b) ∇W_ab.
+//! the divergence Σ_b (v_a − v_b)·∇W_ab and the pressure push Σ_b (k_a + k_b) ∇W_ab, over the gradient
+//! records a list holds ([`Grad`]).
 //!
-//! [`pair_sum`] is the generic loop; in 3D the lists hold each gradient (and the solver each velocity) in
-//! four lanes, and on x86_64 [`divergence`] and [`push`] run the same additions in the same order on
-//! 128-bit registers: one load per neighbour's velocity and one per gradient instead of three each (the
-//! loops were bound by loads), and where the CPU has AVX two neighbours per 256-bit register. The results
-//! are the same to the bit as [`pair_sum`]'s (tested).
+//! [`pair_sum`] is the generic loop. In 3D the lists hold each gradient in half precision
+//! ([`Half4`](super::half::Half4), 8 bytes a pair: the lists outgrow the L2 caches and the passes wait on
+//! memory) and the solver each velocity in four lanes; on x86_64 with AVX2 (and so F16C) the sums convert
+//! two pairs' gradients with one instruction and run two pairs per 256-bit register, one load per
+//! neighbour's velocity; the results are the same to the bit as [`pair_sum`]'s over the converted
+//! gradients (tested).
 
+use super::half::Half4;
 /// Independent partial sums a neighbour-list loop keeps, so that consecutive pairs do not wait for each
 /// other's additions (one chain per dimension is bound by the adder's latency, not its throughput).
 pub const CHAINS: usize = 4;
@@ -14,24 +17,24 @@ pub const CHAINS: usize = 4;
 /// Σ over a particle's neighbour list of `term(j, ∇W)`, summed in [`CHAINS`] interleaved partial sums (a
 /// fixed order: the result depends only on the list, not on threads).
 #[inline(always)]
-pub fn pair_sum<const W: usize>(
+pub fn pair_sum<R: Copy, const W: usize>(
     j: &[u32],
-    g: &[[f32; W]],
-    term: impl Fn(u32, &[f32; W]) -> [f32; W],
+    g: &[R],
+    term: impl Fn(u32, R) -> [f32; W],
 ) -> [f32; W] {
     let mut acc = [[0.0f32; W]; CHAINS];
     let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
     let (gc, gr) = g.split_at(jc.len());
     for (js, gs) in jc.chunks_exact(CHAINS).zip(gc.chunks_exact(CHAINS)) {
         for l in 0..CHAINS {
-            let t = term(js[l], &gs[l]);
+            let t = term(js[l], gs[l]);
             for d in 0..W {
                 acc[l][d] += t[d];
             }
         }
     }
     for (l, (jj, gg)) in jr.iter().zip(gr).enumerate() {
-        let t = term(*jj, gg);
+        let t = term(*jj, *gg);
         for d in 0..W {
             acc[l][d] += t[d];
         }
@@ -39,185 +42,170 @@ pub fn pair_sum<const W: usize>(
     std::array::from_fn(|d| (acc[0][d] + acc[1][d]) + (acc[2][d] + acc[3][d]))
 }
 
-/// Σ_b (v_a − v_b) ∇W_ab per lane (the divergence is the sum of its first D lanes); in four lanes two pairs
-/// at a time on 256-bit registers where `wide`.
-///
-/// # Safety
-/// Every index in `j` is below `vel.len()` (the neighbours' velocities are read unchecked); `wide` only
-/// where the CPU has AVX.
-#[inline(always)]
-pub unsafe fn divergence<const W: usize>(
-    j: &[u32],
-    g: &[[f32; W]],
-    vel: &[[f32; W]],
-    va: [f32; W],
-    wide: bool,
-) -> [f32; W] {
-    #[cfg(target_arch = "x86_64")]
-    if W == 4 {
-        let va = std::array::from_fn(|d| va[d]);
-        // SAFETY: W == 4, so these are the same types; the caller guarantees j < vel.len() and AVX where
-        // `wide`.
-        let r = unsafe {
-            if wide {
-                avx::divergence(j, as4(g), as4(vel), va)
-            } else {
-                sse::divergence(j, as4(g), as4(vel), va)
-            }
-        };
-        return std::array::from_fn(|d| r[d]);
-    }
-    let _ = wide;
-    pair_sum(j, g, |j, g| {
-        // SAFETY: the caller guarantees j < vel.len().
-        let vb = unsafe { vel.get_unchecked(j as usize) };
-        std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
-    })
-}
+/// A kernel gradient as a neighbour list stores it (D dimensions, in W lanes: the velocities the
+/// divergence reads have W lanes too), and the two sums of the pressure iterations over such a list.
+pub trait Grad<const D: usize, const W: usize>: Copy + PartialEq + std::fmt::Debug {
+    /// Whether the 3D neighbourhood pass stores blocks of eight records of this type with AVX2 (F16C).
+    const AVX_BLOCKS: bool;
 
-/// Σ_b (k_a + k_b) ∇W_ab (as [`divergence`] where `wide`).
-///
-/// # Safety
-/// Every index in `j` is below `k.len()` (the neighbours' k are read unchecked); `wide` only where the CPU
-/// has AVX.
-#[inline(always)]
-pub unsafe fn push<const W: usize>(
-    j: &[u32],
-    g: &[[f32; W]],
-    k: &[f32],
-    ka: f32,
-    wide: bool,
-) -> [f32; W] {
-    #[cfg(target_arch = "x86_64")]
-    if W == 4 {
-        // SAFETY: W == 4, so these are the same types; the caller guarantees j < k.len() and AVX where
-        // `wide`.
-        let r = unsafe {
-            if wide {
-                avx::push(j, as4(g), k, ka)
-            } else {
-                sse::push(j, as4(g), k, ka)
-            }
-        };
-        return std::array::from_fn(|d| r[d]);
-    }
-    let _ = wide;
-    pair_sum(j, g, |j, g| {
-        // SAFETY: the caller guarantees j < k.len().
-        let s = ka + unsafe { k.get_unchecked(j as usize) };
-        std::array::from_fn(|d| s * g[d])
-    })
-}
+    /// Records hold ∇W · `scale(h)`.
+    fn scale(h: f32) -> f32;
 
-/// `[[f32; W]]` as `[[f32; 4]]`.
-///
-/// # Safety
-/// W must be 4.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn as4<const W: usize>(v: &[[f32; W]]) -> &[[f32; 4]] {
-    assert_eq!(W, 4);
-    // SAFETY: the caller guarantees W == 4: same size, alignment and layout.
-    unsafe { std::slice::from_raw_parts(v.as_ptr().cast(), v.len()) }
-}
+    /// The record of the scaled gradient `g`.
+    fn pack(g: [f32; D]) -> Self;
 
-#[cfg(target_arch = "x86_64")]
-mod sse {
-    use super::CHAINS;
-    use std::arch::x86_64::*;
+    /// The record's lanes in f32.
+    fn lanes(self) -> [f32; W];
 
-    #[inline(always)]
-    fn load(v: &[f32; 4]) -> __m128 {
-        // SAFETY: 16 readable bytes (SSE is part of x86_64).
-        unsafe { _mm_loadu_ps(v.as_ptr()) }
-    }
-
-    #[inline(always)]
-    fn lanes(v: __m128) -> [f32; 4] {
-        let mut out = [0.0f32; 4];
-        // SAFETY: 16 writable bytes.
-        unsafe { _mm_storeu_ps(out.as_mut_ptr(), v) };
-        out
-    }
-
-    /// [`super::pair_sum`]'s chains and closing additions on four lanes.
-    #[inline(always)]
-    fn chains(j: &[u32], g: &[[f32; 4]], term: impl Fn(u32, __m128) -> __m128) -> [f32; 4] {
-        // SAFETY (the arithmetic intrinsics below): SSE is part of x86_64; they touch no memory (`load` has
-        // its own note).
-        let mut acc = [unsafe { _mm_setzero_ps() }; CHAINS];
-        let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
-        let (gc, gr) = g.split_at(jc.len());
-        for (js, gs) in jc.chunks_exact(CHAINS).zip(gc.chunks_exact(CHAINS)) {
-            for l in 0..CHAINS {
-                acc[l] = unsafe { _mm_add_ps(acc[l], term(js[l], load(&gs[l]))) };
-            }
-        }
-        for (l, (jj, gg)) in jr.iter().zip(gr).enumerate() {
-            acc[l] = unsafe { _mm_add_ps(acc[l], term(*jj, load(gg))) };
-        }
-        lanes(unsafe { _mm_add_ps(_mm_add_ps(acc[0], acc[1]), _mm_add_ps(acc[2], acc[3])) })
-    }
-
-    /// [`super::divergence`] in four lanes.
+    /// Σ_b (v_a − v_b) · record_ab per lane (the divergence is the sum of the first D lanes, divided by
+    /// the scale).
     ///
     /// # Safety
-    /// Every index in `j` is below `vel.len()`.
-    #[inline(always)]
-    pub(super) unsafe fn divergence(
+    /// Every index in `j` is below `vel.len()` (the neighbours' velocities are read unchecked); `wide` only
+    /// where [`wide_lanes`](super::candidates::wide_lanes) holds.
+    unsafe fn divergence(
         j: &[u32],
-        g: &[[f32; 4]],
+        g: &[Self],
+        vel: &[[f32; W]],
+        va: [f32; W],
+        wide: bool,
+    ) -> [f32; W];
+
+    /// Σ_b (k_a + k_b) record_ab (as [`Grad::divergence`]).
+    ///
+    /// # Safety
+    /// Every index in `j` is below `k.len()`; `wide` as for [`Grad::divergence`].
+    unsafe fn push(j: &[u32], g: &[Self], k: &[f32], ka: f32, wide: bool) -> [f32; W];
+}
+
+/// Gradients in f32, the first D of W lanes (the rest 0), unscaled: the 2D lists' records.
+impl<const D: usize, const W: usize> Grad<D, W> for [f32; W] {
+    const AVX_BLOCKS: bool = false;
+
+    #[inline(always)]
+    fn scale(_h: f32) -> f32 {
+        1.0
+    }
+
+    #[inline(always)]
+    fn pack(g: [f32; D]) -> Self {
+        std::array::from_fn(|d| if d < D { g[d] } else { 0.0 })
+    }
+
+    #[inline(always)]
+    fn lanes(self) -> [f32; W] {
+        self
+    }
+
+    #[inline(always)]
+    unsafe fn divergence(
+        j: &[u32],
+        g: &[Self],
+        vel: &[[f32; W]],
+        va: [f32; W],
+        _wide: bool,
+    ) -> [f32; W] {
+        pair_sum(j, g, |j, g| {
+            // SAFETY: the caller guarantees j < vel.len().
+            let vb = unsafe { vel.get_unchecked(j as usize) };
+            std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
+        })
+    }
+
+    #[inline(always)]
+    unsafe fn push(j: &[u32], g: &[Self], k: &[f32], ka: f32, _wide: bool) -> [f32; W] {
+        pair_sum(j, g, |j, g| {
+            // SAFETY: the caller guarantees j < k.len().
+            let s = ka + unsafe { k.get_unchecked(j as usize) };
+            std::array::from_fn(|d| s * g[d])
+        })
+    }
+}
+
+/// Gradients × h⁴ in binary16 (D ≤ 3 lanes of four): the 3D lists' records.
+impl<const D: usize> Grad<D, 4> for Half4 {
+    const AVX_BLOCKS: bool = true;
+
+    #[inline(always)]
+    fn scale(h: f32) -> f32 {
+        Half4::scale(h)
+    }
+
+    #[inline(always)]
+    fn pack(g: [f32; D]) -> Self {
+        Half4::pack(std::array::from_fn(|d| if d < D { g[d] } else { 0.0 }))
+    }
+
+    #[inline(always)]
+    fn lanes(self) -> [f32; 4] {
+        self.unpack()
+    }
+
+    #[inline(always)]
+    unsafe fn divergence(
+        j: &[u32],
+        g: &[Self],
         vel: &[[f32; 4]],
         va: [f32; 4],
+        wide: bool,
     ) -> [f32; 4] {
-        let va = load(&va);
-        chains(j, g, |j, g| {
+        #[cfg(target_arch = "x86_64")]
+        if wide {
+            // SAFETY: the caller guarantees j < vel.len() and AVX2 (so AVX and F16C) where `wide`.
+            return unsafe { avx::divergence(j, g, vel, va) };
+        }
+        let _ = wide;
+        pair_sum(j, g, |j, g| {
             // SAFETY: the caller guarantees j < vel.len().
-            let vb = load(unsafe { vel.get_unchecked(j as usize) });
-            // SAFETY: SSE is part of x86_64.
-            unsafe { _mm_mul_ps(_mm_sub_ps(va, vb), g) }
+            let vb = unsafe { vel.get_unchecked(j as usize) };
+            let g = g.unpack();
+            std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
         })
     }
 
-    /// [`super::push`] in four lanes.
-    ///
-    /// # Safety
-    /// Every index in `j` is below `k.len()`.
     #[inline(always)]
-    pub(super) unsafe fn push(j: &[u32], g: &[[f32; 4]], k: &[f32], ka: f32) -> [f32; 4] {
-        chains(j, g, |j, g| {
-            // SAFETY: SSE is part of x86_64.
+    unsafe fn push(j: &[u32], g: &[Self], k: &[f32], ka: f32, wide: bool) -> [f32; 4] {
+        #[cfg(target_arch = "x86_64")]
+        if wide {
+            // SAFETY: the caller guarantees j < k.len() and AVX2 (so AVX and F16C) where `wide`.
+            return unsafe { avx::push(j, g, k, ka) };
+        }
+        let _ = wide;
+        pair_sum(j, g, |j, g| {
             // SAFETY: the caller guarantees j < k.len().
-            unsafe { _mm_mul_ps(_mm_set1_ps(ka + k.get_unchecked(j as usize)), g) }
+            let s = ka + unsafe { k.get_unchecked(j as usize) };
+            let g = g.unpack();
+            std::array::from_fn(|d| s * g[d])
         })
     }
 }
 
-/// The four-lane sums two pairs at a time: pairs 4n and 4n + 1 share one 256-bit register (the chains 0 and
-/// 1 of [`super::pair_sum`] in its halves), pairs 4n + 2 and 4n + 3 another, so each lane sees the same
-/// additions in the same order as the 128-bit loop and the results are the same to the bit (tested); a
-/// pair of gradients is one 32-byte load, and the arithmetic is half the instructions.
+/// The half-precision sums two pairs at a time: pairs 4n and 4n + 1 share one 256-bit register (the chains
+/// 0 and 1 of [`pair_sum`] in its halves), pairs 4n + 2 and 4n + 3 another, so each lane sees the same
+/// additions in the same order as the generic loop and the results are the same to the bit (tested); two
+/// records are one 16-byte load and one conversion to f32.
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::CHAINS;
+    use super::{Half4, CHAINS};
     use std::arch::x86_64::*;
 
     /// The chains of [`super::pair_sum`] over `$j`/`$g`: `$two(j0, j1, g01)` gives two pairs' terms from
     /// their gradients (one 256-bit register), `$one(j, g)` one pair's (the remainder, 128 bits). A macro,
-    /// not closures: a closure would not inherit the function's AVX, and the intrinsics would be calls.
+    /// not closures: a closure would not inherit the function's target features, and the intrinsics would
+    /// be calls.
     macro_rules! chains {
         ($j:expr, $g:expr, |$j0:ident, $j1:ident, $g2:ident| $two:expr, |$j_:ident, $g1:ident| $one:expr) => {{
-            let (j, g): (&[u32], &[[f32; 4]]) = ($j, $g);
+            let (j, g): (&[u32], &[Half4]) = ($j, $g);
             let (mut a01, mut a23) = (_mm256_setzero_ps(), _mm256_setzero_ps());
             let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
             let (gc, gr) = g.split_at(jc.len());
             for (js, gs) in jc.chunks_exact(CHAINS).zip(gc.chunks_exact(CHAINS)) {
-                // SAFETY: 32 readable bytes: two consecutive records (pointers from the slice, which covers
+                // SAFETY: 16 readable bytes: two consecutive records (pointers from the slice, which covers
                 // both).
                 let (g01, g23) = unsafe {
                     (
-                        _mm256_loadu_ps(gs[..2].as_ptr().cast()),
-                        _mm256_loadu_ps(gs[2..].as_ptr().cast()),
+                        _mm256_cvtph_ps(_mm_loadu_si128(gs[..2].as_ptr().cast())),
+                        _mm256_cvtph_ps(_mm_loadu_si128(gs[2..].as_ptr().cast())),
                     )
                 };
                 let ($j0, $j1, $g2) = (js[0], js[1], g01);
@@ -232,8 +220,8 @@ mod avx {
                 _mm256_extractf128_ps::<1>(a23),
             ];
             for (l, (jj, gg)) in jr.iter().zip(gr).enumerate() {
-                // SAFETY: 16 readable bytes.
-                let ($j_, $g1) = (*jj, unsafe { _mm_loadu_ps(gg.as_ptr()) });
+                // SAFETY: 8 readable bytes.
+                let ($j_, $g1) = (*jj, _mm_cvtph_ps(unsafe { _mm_loadl_epi64(gg.0.as_ptr().cast()) }));
                 acc[l] = _mm_add_ps(acc[l], $one);
             }
             let mut out = [0.0f32; 4];
@@ -264,15 +252,15 @@ mod avx {
         }
     }
 
-    /// [`super::divergence`], two pairs at a time.
+    /// [`super::Grad::divergence`] of half records, two pairs at a time.
     ///
     /// # Safety
-    /// The CPU has AVX; every index in `j` is below `vel.len()`.
+    /// The CPU has AVX and F16C; every index in `j` is below `vel.len()`.
     #[inline]
-    #[target_feature(enable = "avx")]
+    #[target_feature(enable = "avx,f16c")]
     pub(super) unsafe fn divergence(
         j: &[u32],
-        g: &[[f32; 4]],
+        g: &[Half4],
         vel: &[[f32; 4]],
         va: [f32; 4],
     ) -> [f32; 4] {
@@ -297,13 +285,13 @@ mod avx {
         )
     }
 
-    /// [`super::push`], two pairs at a time.
+    /// [`super::Grad::push`] of half records, two pairs at a time.
     ///
     /// # Safety
-    /// The CPU has AVX; every index in `j` is below `k.len()`.
+    /// The CPU has AVX and F16C; every index in `j` is below `k.len()`.
     #[inline]
-    #[target_feature(enable = "avx")]
-    pub(super) unsafe fn push(j: &[u32], g: &[[f32; 4]], k: &[f32], ka: f32) -> [f32; 4] {
+    #[target_feature(enable = "avx,f16c")]
+    pub(super) unsafe fn push(j: &[u32], g: &[Half4], k: &[f32], ka: f32) -> [f32; 4] {
         // SAFETY (the neighbours' k): the caller guarantees j < k.len().
         chains!(
             j,
@@ -323,11 +311,12 @@ mod avx {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scheme::candidates::wide_lanes;
 
     /// A made-up list of `len` neighbours among 50 particles (lanes beyond 3 zero, as the solver keeps
-    /// them), their gradients and velocities, and k.
+    /// them), their gradients as half records and velocities, and k.
     #[allow(clippy::type_complexity)]
-    fn data(len: usize) -> (Vec<u32>, Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<f32>) {
+    fn data(len: usize) -> (Vec<u32>, Vec<Half4>, Vec<[f32; 4]>, Vec<f32>) {
         let mut s = 0x2545_f491_u32;
         let mut r = move || {
             s ^= s << 13;
@@ -337,46 +326,45 @@ mod tests {
         };
         let v4 = |r: &mut dyn FnMut() -> f32| [r(), r(), r(), 0.0];
         let j = (0..len).map(|i| ((i * 37 + 11) % 50) as u32).collect();
-        let g = (0..len).map(|_| v4(&mut r)).collect();
+        let g = (0..len)
+            .map(|_| <Half4 as Grad<3, 4>>::pack([r(), r(), r()]))
+            .collect();
         let vel = (0..50).map(|_| v4(&mut r)).collect();
         let k = (0..50).map(|_| r().abs() * 1e3).collect();
         (j, g, vel, k)
     }
 
-    /// The loops a CPU can run: the 128-bit one always, the 256-bit one where it has AVX.
+    /// The loops this CPU can run: the generic one always, the AVX2 one where it has it.
     fn ways() -> Vec<bool> {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx") {
-            return vec![false, true];
+        if wide_lanes() {
+            vec![false, true]
+        } else {
+            vec![false]
         }
-        vec![false]
     }
 
     #[test]
-    fn four_lane_sums_equal_the_generic_loop_to_the_bit() {
+    fn half_record_sums_equal_the_f32_loop_over_their_values_to_the_bit() {
         // Every remainder of the chains, and an empty list.
         for len in [0, 1, 2, 3, 4, 5, 7, 8, 61, 74] {
             let (j, g, vel, k) = data(len);
+            // The same gradients as f32 records: the generic loop.
+            let g32: Vec<[f32; 4]> = g.iter().map(|h| h.unpack()).collect();
             let va = vel[3];
-            let plain = pair_sum(&j, &g, |j, g| {
-                let vb = vel[j as usize];
-                std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
-            });
+            // SAFETY (here and below): every j < 50, the particles' count; `wide` only where
+            // `wide_lanes()` holds.
+            let plain = unsafe { <[f32; 4] as Grad<3, 4>>::divergence(&j, &g32, &vel, va, false) };
             for wide in ways() {
-                // SAFETY (here and below): every j < 50, the particles' count; AVX where `wide`.
-                let fast = unsafe { divergence(&j, &g, &vel, va, wide) };
+                let fast = unsafe { <Half4 as Grad<3, 4>>::divergence(&j, &g, &vel, va, wide) };
                 assert_eq!(
                     plain.map(f32::to_bits),
                     fast.map(f32::to_bits),
                     "divergence, {len} pairs, wide {wide}"
                 );
             }
-            let plain = pair_sum(&j, &g, |j, g| {
-                let s = k[7] + k[j as usize];
-                std::array::from_fn(|d| s * g[d])
-            });
+            let plain = unsafe { <[f32; 4] as Grad<3, 4>>::push(&j, &g32, &k, k[7], false) };
             for wide in ways() {
-                let fast = unsafe { push(&j, &g, &k, k[7], wide) };
+                let fast = unsafe { <Half4 as Grad<3, 4>>::push(&j, &g, &k, k[7], wide) };
                 assert_eq!(
                     plain.map(f32::to_bits),
                     fast.map(f32::to_bits),
@@ -384,28 +372,29 @@ mod tests {
                 );
             }
             assert!(len == 0 || plain.iter().any(|x| *x != 0.0));
+            assert_eq!(plain[3], 0.0, "the padding lane");
         }
     }
 
     #[test]
     fn three_lane_sums_match_the_four_lane_ones() {
-        // 3D without padding (the generic loop) against the padded lanes: same first three lanes.
+        // 3D without padding against the padded lanes: the same first three lanes.
         let (j, g, vel, k) = data(61);
+        let g4: Vec<[f32; 4]> = g.iter().map(|h| h.unpack()).collect();
         let cut = |v: &[[f32; 4]]| v.iter().map(|x| [x[0], x[1], x[2]]).collect::<Vec<_>>();
-        let (g3, vel3) = (cut(&g), cut(&vel));
+        let (g3, vel3) = (cut(&g4), cut(&vel));
         // SAFETY: every j < 50, the particles' count.
         let (d3, d4, p3, p4) = unsafe {
             (
-                divergence(&j, &g3, &vel3, vel3[3], false),
-                divergence(&j, &g, &vel, vel[3], false),
-                push(&j, &g3, &k, k[7], false),
-                push(&j, &g, &k, k[7], false),
+                <[f32; 3] as Grad<3, 3>>::divergence(&j, &g3, &vel3, vel3[3], false),
+                <[f32; 4] as Grad<3, 4>>::divergence(&j, &g4, &vel, vel[3], false),
+                <[f32; 3] as Grad<3, 3>>::push(&j, &g3, &k, k[7], false),
+                <[f32; 4] as Grad<3, 4>>::push(&j, &g4, &k, k[7], false),
             )
         };
         for d in 0..3 {
             assert_eq!(d3[d].to_bits(), d4[d].to_bits());
             assert_eq!(p3[d].to_bits(), p4[d].to_bits());
         }
-        assert_eq!(d4[3], 0.0);
     }
 }
