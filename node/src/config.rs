@@ -1459,6 +1459,12 @@ mod tests {
             m.starts_with("-p: solver.cfl: must be within (0, 1]"),
             "{m}"
         );
+        // The dfsph settings are checked with wcsph too (the default scheme here).
+        let m = checked("solver.dfsph.relaxation=1.5");
+        assert!(
+            m.starts_with("-p: solver.dfsph.relaxation: must be in (0, 1]"),
+            "{m}"
+        );
         // A parameter the override did not set stays the file's.
         let m = err(MIN, &["output_rate_hz=20", "fill_height=0.7"]);
         assert!(m.starts_with("--set: fill_height"), "{m}");

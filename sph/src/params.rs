@@ -478,14 +478,18 @@ impl SimParams {
                 "thomas_couchman is for the cubic spline (the Wendland kernel's gradient does not vanish between close particles): leave it unset or set `exact`",
             ));
         }
-        if self.solver.scheme == Scheme::Dfsph {
+        if self.solver.scheme == Scheme::Dfsph
+            && self.solver.boundary.method != BoundaryMethod::Dynamic
+        {
+            return Err(err(
+                "solver.boundary.method",
+                "the dfsph scheme uses the wall particle layers (`dynamic`); `mirror` is for wcsph",
+            ));
+        }
+        // The dfsph settings are checked whichever the scheme: a case run with wcsph and switched to dfsph
+        // later (`--set solver.scheme=dfsph`) must not meet a bad value only then.
+        {
             let d = &self.solver.dfsph;
-            if self.solver.boundary.method != BoundaryMethod::Dynamic {
-                return Err(err(
-                    "solver.boundary.method",
-                    "the dfsph scheme uses the wall particle layers (`dynamic`); `mirror` is for wcsph",
-                ));
-            }
             if !(d.cfl > 0.0 && d.cfl <= 1.0) {
                 return Err(err(
                     "solver.dfsph.cfl",

@@ -172,7 +172,7 @@ struct Ctx<'a, const D: usize, K> {
     frame: &'a FrameTerms,
     fluid: &'a Fluid<D>,
     bound: &'a Boundary<D>,
-    /// Run the neighbourhood sums with AVX2 + FMA.
+    /// Run the neighbourhood sums with AVX2 + FMA (and F16C for the 3D lists' half records).
     wide: bool,
 }
 
@@ -224,7 +224,7 @@ struct Around<'a, const D: usize> {
 
 /// The neighbourhood of liquid particle (xa, va) among the particles `around` it, selected into `fs`
 /// (liquid) and `bs` (walls) (packed with AVX2 where `wide`); appends its liquid neighbours (not itself)
-/// and their ∇W_ab to `j`/`g` (in W lanes, those beyond D written as 0).
+/// and their ∇W_ab times `R::scale(h)` to `j`/`g` as records R (of W lanes, those beyond D 0).
 /// Branch-free over blocks of [`LANES`]: padding beyond the support adds nothing.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -298,6 +298,8 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
         }
         #[cfg(target_arch = "x86_64")]
         if wide && D == 3 && R::AVX_BLOCKS {
+            // (Only `Half4` stores blocks: eight 8-byte records.)
+            assert_eq!(std::mem::size_of::<R>(), 8);
             let mask = (0..LANES).fold(0usize, |m, l| m | (hit[l] as usize) << l);
             // SAFETY: `wide` holds only where the CPU has AVX2 and F16C; n + LANES ≤ (blk + 1) · LANES ≤
             // the room reserved above (n ≤ blk · LANES); D == 3, and records of `AVX_BLOCKS` types are
@@ -395,10 +397,9 @@ unsafe fn store_block_avx2(
         let perm = _mm256_load_si256(super::near::PACK.0[mask].as_ptr() as *const __m256i);
         let s = _mm256_set1_ps(scale);
         // (No closures here: a closure would not inherit AVX2, and the intrinsics would not be inlined.)
-        let lane = |d: usize| _mm256_mul_ps(_mm256_loadu_ps(gl[d].as_ptr()), s);
-        let x = _mm256_permutevar8x32_ps(lane(0), perm);
-        let y = _mm256_permutevar8x32_ps(lane(1), perm);
-        let z = _mm256_permutevar8x32_ps(lane(2), perm);
+        let x = _mm256_permutevar8x32_ps(_mm256_mul_ps(_mm256_loadu_ps(gl[0].as_ptr()), s), perm);
+        let y = _mm256_permutevar8x32_ps(_mm256_mul_ps(_mm256_loadu_ps(gl[1].as_ptr()), s), perm);
+        let z = _mm256_permutevar8x32_ps(_mm256_mul_ps(_mm256_loadu_ps(gl[2].as_ptr()), s), perm);
         let zero = _mm256_setzero_ps();
         // Per 128-bit half: (x0 y0 x1 y1), (x2 y2 x3 y3), (z0 0 z1 0), (z2 0 z3 0) …
         let (t0, t1) = (_mm256_unpacklo_ps(x, y), _mm256_unpackhi_ps(x, y));
@@ -408,14 +409,20 @@ unsafe fn store_block_avx2(
         let r1 = _mm256_shuffle_ps::<0xEE>(t0, t2);
         let r2 = _mm256_shuffle_ps::<0x44>(t1, t3);
         let r3 = _mm256_shuffle_ps::<0xEE>(t1, t3);
-        // Two records (8 binary16) per store.
+        // Two records (8 binary16, rounded to nearest even) per store.
         const NEAREST: i32 = _MM_FROUND_TO_NEAREST_INT;
-        let half = |r: __m256| _mm256_cvtps_ph::<NEAREST>(r);
-        let st = |at: usize, r: __m256| _mm_storeu_si128(g.add(at) as *mut __m128i, half(r));
-        st(0, _mm256_permute2f128_ps::<0x20>(r0, r1));
-        st(8, _mm256_permute2f128_ps::<0x20>(r2, r3));
-        st(16, _mm256_permute2f128_ps::<0x31>(r0, r1));
-        st(24, _mm256_permute2f128_ps::<0x31>(r2, r3));
+        let (a, b) = (
+            _mm256_permute2f128_ps::<0x20>(r0, r1),
+            _mm256_permute2f128_ps::<0x20>(r2, r3),
+        );
+        _mm_storeu_si128(g as *mut __m128i, _mm256_cvtps_ph::<NEAREST>(a));
+        _mm_storeu_si128(g.add(8) as *mut __m128i, _mm256_cvtps_ph::<NEAREST>(b));
+        let (a, b) = (
+            _mm256_permute2f128_ps::<0x31>(r0, r1),
+            _mm256_permute2f128_ps::<0x31>(r2, r3),
+        );
+        _mm_storeu_si128(g.add(16) as *mut __m128i, _mm256_cvtps_ph::<NEAREST>(a));
+        _mm_storeu_si128(g.add(24) as *mut __m128i, _mm256_cvtps_ph::<NEAREST>(b));
         let i = _mm256_loadu_si256(idx.as_ptr() as *const __m256i);
         _mm256_storeu_si256(j as *mut __m256i, _mm256_permutevar8x32_epi32(i, perm));
     }
@@ -587,7 +594,7 @@ fn error_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
         let va = vel[a];
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
         // SAFETY: every index in the lists is below `end_j` (asserted above); `wide` (from `wide_lanes()`)
-        // only where the CPU has AVX2, so AVX.
+        // only where the CPU has AVX2, so AVX, and F16C.
         let mut s = m * unsafe { R::divergence(&lists.j[lo..hi], &g[lo..hi], vel, va, wide) }
             .iter()
             .take(D)
