@@ -678,6 +678,20 @@ mod tests {
             e.contains(&format!("`slosh bag repair {}`", first.display())),
             "{e}"
         );
+        // One file of a rosbag2 folder (with its metadata.yaml): the folder, which repair copies beside it
+        // (repairing the file would write the new bag inside the damaged one's folder).
+        std::fs::write(
+            split.join("metadata.yaml"),
+            "rosbag2_bagfile_information: {}\n",
+        )
+        .unwrap();
+        let e = crate::replay::bag::for_each_message(&files[..1], |_| Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("`slosh bag repair {}`", split.display())),
+            "{e}"
+        );
         let _ = std::fs::remove_dir_all(&d);
     }
 

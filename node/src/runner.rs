@@ -65,6 +65,9 @@ pub struct Drive<'a> {
     pub record: Option<(RecordCfg, &'a mut RecordState<'a>)>,
     /// Extra facts for `summary.json` (e.g. where a replay's motion came from).
     pub input: Option<serde_json::Value>,
+    /// Called once the run's options are checked and its outputs created, before the first step (a
+    /// replay says there what it replays and where it writes).
+    pub started: Option<Box<dyn FnOnce() + 'a>>,
 }
 
 /// Runs a case headless into `out`; returns the summary that was also written to `out/summary.json`.
@@ -80,6 +83,7 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
         out,
         opts,
         Drive {
+            started: None,
             motion: motion.as_ref(),
             record: (!cfg.config.record.path.is_empty())
                 .then(|| (cfg.config.record.clone(), &mut record as &mut RecordState)),
@@ -169,6 +173,9 @@ pub fn drive(
         Some(s) => Some((SnapshotWriter::create(s)?, s.rate_hz)),
         None => None,
     };
+    if let Some(f) = d.started {
+        f();
+    }
     let mut sim = sph::build(params.clone()).map_err(|e| RunError::Solver {
         error: e,
         time: 0.0,

@@ -240,9 +240,20 @@ fn damaged_and_ambiguous_bags_get_errors_naming_the_problem() {
         for e in expect {
             assert!(err.contains(e), "{name}: `{e}` not in: {err}");
         }
+        // A refused replay does not announce outputs it never writes.
+        assert!(!err.contains("writing to"), "{name}: {err}");
     };
     fails(&dir.join("missing"), &[], &["no such file or folder"]);
     let good = write_bag(&dir, "good", &[]);
+    fails(
+        &good,
+        &["--duration", "100"],
+        &["before the requested duration of 100 s", "ask for at most"],
+    );
+    assert!(
+        !out("good").exists(),
+        "a refused replay left its output folder"
+    );
     let truncated = dir.join("truncated.mcap");
     let bytes = std::fs::read(good.join("good.mcap")).unwrap();
     std::fs::write(&truncated, &bytes[..bytes.len() * 2 / 3]).unwrap();
@@ -316,6 +327,15 @@ fn damaged_and_ambiguous_bags_get_errors_naming_the_problem() {
     );
     assert!(ok, "{err}");
     assert_eq!(summary(&out("two_chosen"))["input"]["topic"], "/gps/odom");
+    // A relative name resolves against the root namespace, as in ROS 2.
+    let (ok, err) = replay(
+        &two,
+        &case,
+        &out("two_relative"),
+        &[&short[..], &["--topic", "gps/odom"]].concat(),
+    );
+    assert!(ok, "{err}");
+    assert_eq!(summary(&out("two_relative"))["input"]["topic"], "/gps/odom");
     let (ok, err) = replay(
         &dup,
         &case,

@@ -133,9 +133,14 @@ pub fn for_each_message(
                     file,
                     format!(
                         "truncated or corrupt after {n} messages ({e}); `slosh bag repair {}` recovers the messages of its complete chunks into a new bag",
-                        // A split bag is repaired whole: its other files' messages too.
-                        match (files.len() > 1, file.parent()) {
-                            (true, Some(dir)) => dir.display(),
+                        // A rosbag2 folder is repaired whole (a split bag's other files' messages too), into a
+                        // new folder beside it, not inside it.
+                        match file.parent() {
+                            Some(dir)
+                                if files.len() > 1 || dir.join("metadata.yaml").is_file() =>
+                            {
+                                dir.display()
+                            }
                             _ => file.display(),
                         }
                     ),

@@ -81,8 +81,9 @@ pub struct Found {
     pub input_check: String,
 }
 
-/// Replays `bag` through the case `cfg` into `out`; `announce` is told what motion was found before the
-/// simulation starts.
+/// Replays `bag` through the case `cfg` into `out`; `announce` is told what motion was found once the
+/// run's options are checked and its outputs created, before the simulation starts (not at all when the
+/// replay is refused).
 pub fn replay(
     bag_path: &Path,
     cfg: &Loaded,
@@ -146,7 +147,6 @@ pub fn replay(
         recording: record_cfg.path.clone(),
         input_check,
     };
-    announce(&found);
     let tank_frame = c.frames.tank.clone();
     let topics = output_topics();
     let mut next = 0;
@@ -182,6 +182,8 @@ pub fn replay(
             motion: bm.motion.as_ref(),
             record: Some((record_cfg, &mut record as &mut RecordState)),
             input: Some(input),
+            // Said once the outputs exist: a replay refused by its options writes nothing and says so.
+            started: Some(Box::new(|| announce(&found))),
         },
     )?)
 }

@@ -131,7 +131,7 @@ pub fn read(bag: &Path, files: &[PathBuf], how: &Reading) -> Result<BagMotion, B
         }
         f.count += 1;
         let wanted = match how.topic {
-            Some(t) => t == ch.topic,
+            Some(t) => t == ch.topic || names_relative(t, &ch.topic),
             None => Kind::of(&type_name).is_some(),
         };
         if wanted {
@@ -159,6 +159,11 @@ fn listing(found: &BTreeMap<String, Found>, only_motion: bool) -> String {
     }
 }
 
+/// Whether `t` is the relative form of the absolute topic name `name` (`motion/odom` of `/motion/odom`).
+fn names_relative(t: &str, name: &str) -> bool {
+    !t.starts_with('/') && name.strip_prefix('/') == Some(t)
+}
+
 fn choose<'f>(
     bag: &Path,
     found: &'f BTreeMap<String, Found>,
@@ -166,7 +171,12 @@ fn choose<'f>(
 ) -> Result<(&'f str, &'f Found), BagError> {
     let types = "nav_msgs/msg/Odometry, geometry_msgs/msg/PoseStamped or sensor_msgs/msg/Imu";
     if let Some(t) = topic {
-        let Some((name, f)) = found.get_key_value(t) else {
+        // The bag's name, or a relative one (`motion/odom`, as ROS 2 users and the README's topic table
+        // write it) resolved against the root namespace, as the bag's names are.
+        let Some((name, f)) = found
+            .get_key_value(t)
+            .or_else(|| found.iter().find(|(n, _)| names_relative(t, n)))
+        else {
             return Err(BagError::new(
                 bag,
                 format!(
