@@ -43,11 +43,12 @@ fn main() -> anyhow::Result<()> {
     if bench {
         // Transport alone (against `slosh couple --dry`, which answers without simulating): one round trip
         // per sample.
+        let start: f64 = arg("--start", "0").parse()?;
         let mut rtt: Vec<f64> = (0..steps)
             .map(|i| {
                 let t = Instant::now();
                 client
-                    .step(&sample(i as f64 * dt, 0.0, 0.0, 0.0))
+                    .step(&sample(start + i as f64 * dt, 0.0, 0.0, 0.0))
                     .map(|_| t.elapsed().as_secs_f64() * 1e6)
             })
             .collect::<anyhow::Result<_>>()?;

@@ -56,6 +56,44 @@ fn walls_thinner_than_the_kernel_are_refused_by_name() {
 }
 
 #[test]
+fn an_opening_that_cuts_nothing_and_a_centre_of_gravity_outside_the_box_are_refused_by_name() {
+    let refused = |name: &str, set: &str, expect: &[&str]| {
+        let out = slosh()
+            .args(["run", "flooding_case_a", "--duration", "0.01", "--out"])
+            .arg(common::tmp(name).join("out"))
+            .args(["--set", set])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{set} accepted");
+        let err = String::from_utf8_lossy(&out.stderr);
+        for e in expect {
+            assert!(err.contains(e), "{set}: `{e}` not in {err}");
+        }
+    };
+    // Above the box (a frame or units mix-up): the box stayed intact and the case ran as if undamaged.
+    refused(
+        "bodies_opening_above",
+        "bodies.box.openings.damage.centre=[0.0, 0.0, 0.5]",
+        &[
+            "bodies.box.openings.damage",
+            "does not cut through a wall",
+            "box: x -0.0500..0.0500",
+        ],
+    );
+    // Inside the hollow, short of every wall.
+    refused(
+        "bodies_opening_inside",
+        "bodies.box.openings.damage={centre: [0.0, 0.0, 0.05], size: [0.02, 1.0, 0.02]}",
+        &["bodies.box.openings.damage", "does not cut through a wall"],
+    );
+    refused(
+        "bodies_cog_outside",
+        "bodies.box.centre_of_gravity=[0.0, 0.0, 0.5]",
+        &["bodies.box.centre_of_gravity", "outside the box"],
+    );
+}
+
+#[test]
 fn a_damaged_box_floods_and_its_motion_is_recorded_as_odometry() {
     let dir = common::tmp("bodies_flood");
     let bag = dir.join("bag");

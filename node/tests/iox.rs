@@ -239,6 +239,21 @@ fn the_example_client_couples_particles_flow_and_a_killed_client_disturbs_nothin
     let case = dir.join("case.yaml");
     std::fs::write(&case, CASE).unwrap();
     let srv = server(&case, &["--particles", "20"]);
+    // A second server on the same service is refused with the fix (iceoryx2 says only
+    // ExceedsMaxSupportedServers); the first goes on serving.
+    let second = slosh()
+        .arg("couple")
+        .arg(&case)
+        .args(["--service", "t", "--max-steps", "1"])
+        .output()
+        .unwrap();
+    assert!(!second.status.success());
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert!(
+        err.contains("t/coupling is already served by another process")
+            && err.contains("--service"),
+        "{err}"
+    );
 
     // Particle frames, read zero-copy.
     let node = node("test_viewer").unwrap();
@@ -309,6 +324,45 @@ fn the_example_client_couples_particles_flow_and_a_killed_client_disturbs_nothin
         let r = client.step(&sample_of(t, &motion.state(0.0))).unwrap();
         assert_eq!(r.status, STATUS_OK, "after the kill: {}", r.message());
     }
+    drop(client);
+    // A client killed while the server works on its sample (a 4 s step here) leaves that answer on its
+    // connection, which iceoryx2 may hand to the next client with the answer in it: the client library
+    // drops answers for another time, so each of the next client's samples gets its own.
+    let t1 = t_last + 0.2;
+    let mut victim = Command::new(&example)
+        .args([
+            "--service",
+            "t",
+            "--bench",
+            "--steps",
+            "2",
+            "--dt",
+            "4",
+            "--start",
+        ])
+        .arg(t1.to_string())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(700));
+    victim.kill().unwrap();
+    let _ = victim.wait();
+    let client = CouplingClient::connect("t", Duration::from_secs(120)).unwrap();
+    for k in 1..=3 {
+        let t = t1 + 4.0 + 0.01 * k as f64;
+        let r = client.step(&sample_of(t, &motion.state(0.0))).unwrap();
+        assert_eq!(
+            r.status,
+            STATUS_OK,
+            "after the kill mid-step: {}",
+            r.message()
+        );
+        assert_eq!(r.time, t, "the answer to another sample");
+    }
+    eprintln!(
+        "answers for another sample dropped by the next client: {}",
+        client.stale_answers()
+    );
     drop(client);
     // SIGTERM stops the server cleanly, with its summary.
     let pid = srv.0.as_ref().unwrap().id().to_string();

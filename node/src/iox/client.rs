@@ -15,6 +15,8 @@ pub struct CouplingClient {
     _services: CouplingServices,
     _node: Node<ipc::Service>,
     timeout: Duration,
+    /// Answers received for other samples than the one asked (see [`CouplingClient::step`]).
+    stale: std::cell::Cell<u64>,
 }
 
 impl CouplingClient {
@@ -30,7 +32,13 @@ impl CouplingClient {
             _services: services,
             _node: node,
             timeout,
+            stale: Default::default(),
         })
+    }
+
+    /// Answers dropped so far because they were for another sample's time.
+    pub fn stale_answers(&self) -> u64 {
+        self.stale.get()
     }
 
     /// Whether a server is serving the service now.
@@ -52,13 +60,23 @@ impl CouplingClient {
 
     /// Sends the vessel's state and waits for the answer. A refused sample comes back with
     /// `status == STATUS_REJECTED` (not an error); no answer in time is an error.
+    ///
+    /// Every answer carries its sample's time, and one for another time is dropped: a client killed while
+    /// the server worked on its sample leaves that answer on its connection, and iceoryx2 can hand the
+    /// connection, answer and all, to the next client that connects (measured: the second sample of the
+    /// next client got the dead one's answer).
     pub fn step(&self, s: &MotionSample) -> anyhow::Result<StepOutputs> {
         let pending = self.client.send_copy(*s)?;
         self.notifier.notify()?;
         let end = Instant::now() + self.timeout;
         loop {
             if let Some(r) = pending.receive()? {
-                return Ok(*r.payload());
+                let answer = *r.payload();
+                if answer.time.to_bits() == s.time.to_bits() {
+                    return Ok(answer);
+                }
+                self.stale.set(self.stale.get() + 1);
+                continue;
             }
             let now = Instant::now();
             if now >= end {

@@ -100,7 +100,18 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
 
     let node = node("slosh_couple")?;
     let svc = coupling_services(&node, &opts.service)?;
-    let server: CouplingServer = svc.rr.server_builder().create()?;
+    let server: CouplingServer = svc.rr.server_builder().create().map_err(|e| {
+        use iceoryx2::service::port_factory::server::ServerCreateError;
+        match e {
+            ServerCreateError::ExceedsMaxSupportedServers => anyhow::anyhow!(
+                "{}/coupling is already served by another process (one server per service): stop that \
+                 one, or serve this case under another name with --service NAME (and its clients with the \
+                 same name)",
+                opts.service
+            ),
+            e => e.into(),
+        }
+    })?;
     let listener = svc.request.listener_builder().create()?;
     let notifier = svc.response.notifier_builder().create()?;
     let total = sim.counts().fluid + sim.counts().boundary;

@@ -197,6 +197,33 @@ impl BodySpec {
                 ));
             }
         }
+        // The box in box coordinates: outside faces and the hollow inside the walls.
+        let outer = |k: usize| match k {
+            2 => (0.0, self.size[2]),
+            _ => (-0.5 * self.size[k], 0.5 * self.size[k]),
+        };
+        let inner = |k: usize| (outer(k).0 + t, outer(k).1 - t);
+        let span = |k: usize, (a, b): (f64, f64)| format!("{} {a:.4}..{b:.4}", ["x", "y", "z"][k]);
+        let extent = |e: &dyn Fn(usize) -> (f64, f64)| {
+            axes.iter()
+                .map(|&k| span(k, e(k)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        if axes.iter().any(|&k| {
+            let (a, b) = outer(k);
+            !(a..=b).contains(&self.centre_of_gravity[k])
+        }) {
+            return Err(err(
+                f("centre_of_gravity"),
+                format!(
+                    "{:?} m is outside the box ({} m; box coordinates: origin at the centre of its bottom \
+                     face, z up)",
+                    axes.iter().map(|&k| self.centre_of_gravity[k]).collect::<Vec<_>>(),
+                    extent(&outer)
+                ),
+            ));
+        }
         for (group, regions) in [("openings", &self.openings), ("bulkheads", &self.bulkheads)] {
             for o in regions {
                 finite3(f(&format!("{group}.{}.centre", o.name)), &o.centre)?;
@@ -207,6 +234,53 @@ impl BodySpec {
                         "every extent must be positive",
                     ));
                 }
+            }
+        }
+        for o in &self.openings {
+            let (lo, hi) = (
+                |k: usize| o.centre[k] - 0.5 * o.size[k],
+                |k: usize| o.centre[k] + 0.5 * o.size[k],
+            );
+            // Through a wall: across it (from outside its outer face to inside its inner face) along one
+            // axis, and opening into the hollow along the others.
+            let through = axes.iter().any(|&k| {
+                let across = (lo(k) <= outer(k).0 && hi(k) >= inner(k).0)
+                    || (hi(k) >= outer(k).1 && lo(k) <= inner(k).1);
+                across
+                    && axes
+                        .iter()
+                        .filter(|&&m| m != k)
+                        .all(|&m| lo(m) < inner(m).1 && hi(m) > inner(m).0)
+            });
+            // Or through a bulkhead (a duct between compartments): across its thickness along one axis,
+            // overlapping it along the others.
+            let duct = self.bulkheads.iter().any(|b| {
+                let (blo, bhi) = (
+                    |k: usize| b.centre[k] - 0.5 * b.size[k],
+                    |k: usize| b.centre[k] + 0.5 * b.size[k],
+                );
+                axes.iter().any(|&k| {
+                    lo(k) <= blo(k)
+                        && hi(k) >= bhi(k)
+                        && axes
+                            .iter()
+                            .filter(|&&m| m != k)
+                            .all(|&m| lo(m) < bhi(m) && hi(m) > blo(m))
+                })
+            });
+            if !(through || duct) {
+                return Err(err(
+                    f(&format!("openings.{}", o.name)),
+                    format!(
+                        "does not cut through a wall into the hollow (nor through a bulkhead), so it would \
+                         leave the box intact: the region ({} m) must reach from outside a wall's outer face \
+                         past its inner face, and overlap the hollow along the other axes (box: {} m, hollow: \
+                         {} m; box coordinates: origin at the centre of its bottom face, z up)",
+                        extent(&|k| (lo(k), hi(k))),
+                        extent(&outer),
+                        extent(&inner)
+                    ),
+                ));
             }
         }
         for s in &self.springs {
