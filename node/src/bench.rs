@@ -82,6 +82,21 @@ pub struct BenchResult {
 
 /// Runs one case for `duration` simulated seconds (setup excluded from the timing), with `set` (KEY=VALUE)
 /// applied after the case's own overrides.
+/// Checks a case with the overrides `set` (its config, solver parameters and motion) without running it:
+/// `slosh bench` refuses a bad `--set` before it prints anything.
+pub fn check_case(case: &Case, set: &[String]) -> anyhow::Result<()> {
+    let overrides: Vec<String> = case
+        .overrides
+        .iter()
+        .map(|s| s.to_string())
+        .chain(set.iter().cloned())
+        .collect();
+    let cfg = config::load(case.builtin, &overrides)?;
+    cfg.sim_params()?;
+    crate::motion_source::build(&cfg)?;
+    Ok(())
+}
+
 pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::Result<BenchResult> {
     let overrides: Vec<String> = case
         .overrides

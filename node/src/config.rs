@@ -522,10 +522,10 @@ fn plain_type_error(message: &str, key: &str) -> String {
         );
     }
     for (rust, plain) in [
-        ("expected usize", "expected a whole number"),
-        ("expected u64", "expected a whole number"),
-        ("expected u32", "expected a whole number"),
-        ("expected u16", "expected a whole number"),
+        ("expected usize", "expected a whole number of zero or more"),
+        ("expected u64", "expected a whole number of zero or more"),
+        ("expected u32", "expected a whole number of zero or more"),
+        ("expected u16", "expected a whole number of zero or more"),
         ("expected f64", "expected a number"),
     ] {
         if let Some(head) = message.strip_suffix(rust) {
@@ -1113,6 +1113,7 @@ impl Loaded {
     fn regular_here(&self) -> Result<[RegularDof; 6], ConfigError> {
         let r = &self.config.motion.regular;
         let src = &self.source_name;
+        self.synthetic_motion_checks("regular", "amplitude", &r.amplitude)?;
         let a = six(src, "motion.regular.amplitude", &r.amplitude)?;
         let t = six(src, "motion.regular.period", &r.period)?;
         let ph = six(src, "motion.regular.phase", &r.phase)?;
@@ -1128,6 +1129,11 @@ impl Loaded {
     fn irregular_here(&self) -> Result<[JonswapDof; 6], ConfigError> {
         let r = &self.config.motion.irregular;
         let src = &self.source_name;
+        self.synthetic_motion_checks(
+            "irregular",
+            "significant_amplitude",
+            &r.significant_amplitude,
+        )?;
         let a = six(
             src,
             "motion.irregular.significant_amplitude",
@@ -1154,6 +1160,37 @@ impl Loaded {
             ));
         }
         Ok(out)
+    }
+
+    /// What regular and irregular motion share: a ramp of zero or more seconds, and some amplitude (a
+    /// synthetic source whose amplitudes are all missing or zero would run a tank at rest, silently).
+    fn synthetic_motion_checks(
+        &self,
+        source: &str,
+        amplitude: &str,
+        values: &[f64],
+    ) -> Result<(), ConfigError> {
+        let ramp = self.config.motion.ramp_time;
+        if !(ramp.is_finite() && ramp >= 0.0) {
+            return Err(key_err(
+                self.source_of("motion.ramp_time"),
+                "motion.ramp_time",
+                format!("must be zero or more seconds, got {ramp}"),
+            ));
+        }
+        if values.iter().all(|v| *v == 0.0) {
+            let key = format!("motion.{source}.{amplitude}");
+            return Err(key_err(
+                self.source_of("motion.source"),
+                &key,
+                format!(
+                    "motion.source is {source}, but every {amplitude} is {}: give six values ({DOF_NAMES}), \
+                     or set motion.source: none for a tank at rest",
+                    if values.is_empty() { "missing" } else { "0" }
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The motion file's path.
@@ -1295,6 +1332,38 @@ mod tests {
         let e = err(MIN, &["dimension=3D"]);
         assert!(
             e.contains("expected a whole number") && !e.contains("usize"),
+            "{e}"
+        );
+        let e = err(MIN, &["solver.boundary.layers=-1"]);
+        assert!(
+            e.contains("solver.boundary.layers") && e.contains("a whole number of zero or more"),
+            "{e}"
+        );
+        // Synthetic motion: a negative ramp, and a source switched on without amplitudes (it ran a tank at
+        // rest, silently), named with the option that chose the source.
+        let motion_err = |o: &[&str]| {
+            let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
+            let l = from_str(MIN, "case.yaml", None, &o).unwrap();
+            crate::motion_source::build(&l).err().unwrap().to_string()
+        };
+        let e = motion_err(&["motion.source=irregular"]);
+        assert!(
+            e.starts_with("--set: motion.irregular.significant_amplitude: motion.source is irregular, but every significant_amplitude is missing")
+                && e.contains("motion.source: none"),
+            "{e}"
+        );
+        let e = motion_err(&[
+            "motion.source=regular",
+            "motion.regular.amplitude=[0,0,0,0,0,0]",
+        ]);
+        assert!(e.contains("every amplitude is 0"), "{e}");
+        let e = motion_err(&[
+            "motion.source=regular",
+            "motion.regular={amplitude: [0.01, 0, 0, 0, 0, 0], period: [1, 1, 1, 1, 1, 1], phase: [0, 0, 0, 0, 0, 0]}",
+            "motion.ramp_time=-1",
+        ]);
+        assert!(
+            e.starts_with("--set: motion.ramp_time: must be zero or more seconds, got -1"),
             "{e}"
         );
         assert!(

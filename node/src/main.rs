@@ -408,20 +408,25 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             visuals,
         } => {
             let loaded = config::load(&cfg, &set)?;
-            eprintln!(
-                "slosh: running {} for {} s, writing to {}",
-                loaded.source_name,
-                duration.unwrap_or(loaded.config.duration),
-                out.display()
-            );
             let opts = runner::RunOptions {
                 duration,
                 progress: true,
                 rate: None,
                 snapshots: visuals.snapshots(&out),
             };
-            let s =
-                visuals.plot_after(&out, runner::run(&loaded, &out, &opts).map_err(Into::into))?;
+            // Said once the case and options have passed their checks and the outputs exist.
+            let announce = || {
+                eprintln!(
+                    "slosh: running {} for {} s, writing to {}",
+                    loaded.source_name,
+                    duration.unwrap_or(loaded.config.duration),
+                    out.display()
+                )
+            };
+            let s = visuals.plot_after(
+                &out,
+                runner::run(&loaded, &out, &opts, announce).map_err(Into::into),
+            )?;
             println!(
                 "done: {:.3} s simulated in {:.1} s (real-time factor {:.3}, {:.2e} particle-steps/s, {} liquid + {} boundary particles, {} lost)",
                 s.sim_time_s, s.wall_time_s, s.realtime_factor, s.particle_steps_per_s, s.particles_fluid, s.particles_boundary, s.particles_lost
@@ -619,6 +624,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     })
                     .collect::<anyhow::Result<_>>()?
             };
+            // Every case checked first: a bad --set leaves no half table on stdout.
+            for c in &cases {
+                bench::check_case(c, &set).with_context(|| format!("case {}", c.name))?;
+            }
             if !json {
                 println!(
                     "{:<22} {:>5} {:>7} {:>9} {:>8} {:>8} {:>10} {:>14} {:>10} {:>12} {:>7}",

@@ -71,7 +71,14 @@ pub struct Drive<'a> {
 }
 
 /// Runs a case headless into `out`; returns the summary that was also written to `out/summary.json`.
-pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
+/// `announce` is called once the case and options are checked and the outputs created (not at all when
+/// the run is refused).
+pub fn run(
+    cfg: &Loaded,
+    out: &Path,
+    opts: &RunOptions,
+    announce: impl FnOnce(),
+) -> Result<Summary, RunError> {
     let params = cfg.sim_params()?;
     let motion = motion_source::build(cfg)?;
     let frame = cfg.config.frames.tank.clone();
@@ -83,7 +90,7 @@ pub fn run(cfg: &Loaded, out: &Path, opts: &RunOptions) -> Result<Summary, RunEr
         out,
         opts,
         Drive {
-            started: None,
+            started: Some(Box::new(announce)),
             motion: motion.as_ref(),
             record: (!cfg.config.record.path.is_empty())
                 .then(|| (cfg.config.record.clone(), &mut record as &mut RecordState)),

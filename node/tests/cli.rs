@@ -364,6 +364,38 @@ fn bench_reports_json_and_applies_overrides() {
         "{}",
         String::from_utf8_lossy(&st.stderr)
     );
+    // A value out of range, in table mode: refused before the table's header, so stdout stays empty.
+    let st = slosh()
+        .args(["bench", "--case", "seed_2d_dp8mm", "--set", "solver.cfl=5"])
+        .output()
+        .unwrap();
+    assert!(!st.status.success());
+    assert!(
+        st.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&st.stdout)
+    );
+    assert!(String::from_utf8_lossy(&st.stderr).contains("solver.cfl: must be within (0, 1]"));
+    // And a run refused for its values does not announce itself first.
+    let st = slosh()
+        .args([
+            "run",
+            "seed_tank_039",
+            "--duration",
+            "0.1",
+            "--set",
+            "solver.cfl=5",
+            "--out",
+        ])
+        .arg(common::tmp("refused_run").join("out"))
+        .output()
+        .unwrap();
+    assert!(!st.status.success());
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("solver.cfl") && !err.contains("slosh: running"),
+        "{err}"
+    );
 }
 
 #[test]
