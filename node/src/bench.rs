@@ -80,24 +80,11 @@ pub struct BenchResult {
     pub comm_share: f64,
 }
 
-/// Runs one case for `duration` simulated seconds (setup excluded from the timing), with `set` (KEY=VALUE)
-/// applied after the case's own overrides.
-/// Checks a case with the overrides `set` (its config, solver parameters and motion) without running it:
-/// `slosh bench` refuses a bad `--set` before it prints anything.
-pub fn check_case(case: &Case, set: &[String]) -> anyhow::Result<()> {
-    let overrides: Vec<String> = case
-        .overrides
-        .iter()
-        .map(|s| s.to_string())
-        .chain(set.iter().cloned())
-        .collect();
-    let cfg = config::load(case.builtin, &overrides)?;
-    cfg.sim_params()?;
-    crate::motion_source::build(&cfg)?;
-    Ok(())
-}
-
-pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::Result<BenchResult> {
+/// A case with the overrides `set` applied after its own: its solver parameters and motion, checked.
+fn load_case(
+    case: &Case,
+    set: &[String],
+) -> anyhow::Result<(sph::params::SimParams, Box<dyn TankMotion>)> {
     let overrides: Vec<String> = case
         .overrides
         .iter()
@@ -106,7 +93,20 @@ pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::R
         .collect();
     let cfg = config::load(case.builtin, &overrides)?;
     let params = cfg.sim_params()?;
-    let motion: Box<dyn TankMotion> = crate::motion_source::build(&cfg)?;
+    let motion = crate::motion_source::build(&cfg)?;
+    Ok((params, motion))
+}
+
+/// Checks a case with the overrides `set` (its config, solver parameters and motion) without running it:
+/// `slosh bench` refuses a bad `--set` before it prints anything.
+pub fn check_case(case: &Case, set: &[String]) -> anyhow::Result<()> {
+    load_case(case, set).map(|_| ())
+}
+
+/// Runs one case for `duration` simulated seconds (setup excluded from the timing), with `set` (KEY=VALUE)
+/// applied after the case's own overrides.
+pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::Result<BenchResult> {
+    let (params, motion) = load_case(case, set)?;
     let mut sim = sph::build(params)?;
     let duration = duration.unwrap_or(case.duration);
     let start = Instant::now();
