@@ -1038,7 +1038,14 @@ impl Loaded {
         };
         p.validate()
             .map_err(|e| key_err(src, &e.field, e.message))?;
-        crate::memory::check(&p).map_err(|m| key_err(src, "particle_spacing", m))?;
+        crate::memory::check(&p).map_err(|m| {
+            let auto = if c.realtime.auto_resolution.enabled {
+                " (realtime.auto_resolution tries particle_spacing as its finest spacing: it must fit too)"
+            } else {
+                ""
+            };
+            key_err(src, "particle_spacing", format!("{m}{auto}"))
+        })?;
         if !(c.output_rate_hz.is_finite() && c.output_rate_hz > 0.0) {
             return Err(key_err(
                 src,
@@ -1393,6 +1400,19 @@ mod tests {
         assert!(
             e.contains("--set: particle_spacing: 0.00001 m makes about")
                 && e.contains("use a spacing of at least"),
+            "{e}"
+        );
+        // With auto resolution the requested spacing is the finest tried: said so.
+        let e = err(
+            MIN,
+            &[
+                "particle_spacing=2e-5",
+                "realtime.auto_resolution.enabled=true",
+            ],
+        );
+        assert!(
+            e.contains("makes about")
+                && e.contains("realtime.auto_resolution tries particle_spacing"),
             "{e}"
         );
         assert!(err(MIN, &["solver"]).contains("an override must look like key.sub=value"));
