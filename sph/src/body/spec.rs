@@ -237,36 +237,15 @@ impl BodySpec {
             }
         }
         for o in &self.openings {
-            let (lo, hi) = (
-                |k: usize| o.centre[k] - 0.5 * o.size[k],
-                |k: usize| o.centre[k] + 0.5 * o.size[k],
-            );
-            // Through a wall: across it (from outside its outer face to inside its inner face) along one
-            // axis, and opening into the hollow along the others.
+            // Through a wall (from outside its outer face past its inner face, on either side, opening
+            // into the hollow along the other axes), or through a bulkhead (a duct between compartments).
             let through = axes.iter().any(|&k| {
-                let across = (lo(k) <= outer(k).0 && hi(k) >= inner(k).0)
-                    || (hi(k) >= outer(k).1 && lo(k) <= inner(k).1);
-                across
-                    && axes
-                        .iter()
-                        .filter(|&&m| m != k)
-                        .all(|&m| lo(m) < inner(m).1 && hi(m) > inner(m).0)
+                o.crosses(axes, k, (outer(k).0, inner(k).0), &inner)
+                    || o.crosses(axes, k, (inner(k).1, outer(k).1), &inner)
             });
-            // Or through a bulkhead (a duct between compartments): across its thickness along one axis,
-            // overlapping it along the others.
             let duct = self.bulkheads.iter().any(|b| {
-                let (blo, bhi) = (
-                    |k: usize| b.centre[k] - 0.5 * b.size[k],
-                    |k: usize| b.centre[k] + 0.5 * b.size[k],
-                );
-                axes.iter().any(|&k| {
-                    lo(k) <= blo(k)
-                        && hi(k) >= bhi(k)
-                        && axes
-                            .iter()
-                            .filter(|&&m| m != k)
-                            .all(|&m| lo(m) < bhi(m) && hi(m) > blo(m))
-                })
+                axes.iter()
+                    .any(|&k| o.crosses(axes, k, b.bounds(k), &|m| b.bounds(m)))
             });
             if !(through || duct) {
                 return Err(err(
@@ -276,7 +255,7 @@ impl BodySpec {
                          leave the box intact: the region ({} m) must reach from outside a wall's outer face \
                          past its inner face, and overlap the hollow along the other axes (box: {} m, hollow: \
                          {} m; box coordinates: origin at the centre of its bottom face, z up)",
-                        extent(&|k| (lo(k), hi(k))),
+                        extent(&|k| o.bounds(k)),
                         extent(&outer),
                         extent(&inner)
                     ),
@@ -314,6 +293,32 @@ impl BodySpec {
 }
 
 impl RegionSpec {
+    /// Its extent along axis `k`, box coordinates, m.
+    fn bounds(&self, k: usize) -> (f64, f64) {
+        (
+            self.centre[k] - 0.5 * self.size[k],
+            self.centre[k] + 0.5 * self.size[k],
+        )
+    }
+
+    /// Whether the region covers the interval `across` along axis `k` and overlaps `window` (an extent per
+    /// axis) along the other `axes`: it cuts through a slab from one face to the other.
+    fn crosses(
+        &self,
+        axes: &[usize],
+        k: usize,
+        (a, b): (f64, f64),
+        window: &dyn Fn(usize) -> (f64, f64),
+    ) -> bool {
+        let (lo, hi) = self.bounds(k);
+        lo <= a
+            && hi >= b
+            && axes.iter().filter(|&&m| m != k).all(|&m| {
+                let ((lo, hi), (wa, wb)) = (self.bounds(m), window(m));
+                lo < wb && hi > wa
+            })
+    }
+
     /// Whether a point in box coordinates lies in the region (2D: ignoring y).
     pub fn contains(&self, p: [f64; 3], dimension: usize) -> bool {
         (0..3)

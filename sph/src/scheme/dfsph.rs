@@ -251,7 +251,7 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
         wflux: z,
         walls: z,
     };
-    let (first, first_g) = (j.len(), g.len());
+    let first = j.len();
     // What the records hold: ∇W times this.
     let scale = R::scale(c.pair.h);
     // Every lane is written after the end of the list and kept only if it is a neighbour (no branches on
@@ -326,7 +326,7 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
     // SAFETY: the first n entries of the spare capacity were written above.
     unsafe {
         j.set_len(first + n);
-        g.set_len(first_g + n);
+        g.set_len(first + n);
     }
     for blk in 0..bs.blocks() {
         let (dxs, ws, _) = bs.block(blk);

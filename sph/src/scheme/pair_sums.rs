@@ -4,12 +4,13 @@
 //!
 //! [`pair_sum`] is the generic loop. In 3D the lists hold each gradient in half precision
 //! ([`Half4`](super::half::Half4), 8 bytes a pair: the lists outgrow the L2 caches and the passes wait on
-//! memory) and the solver each velocity in four lanes; on x86_64 with AVX2 (and so F16C) the sums convert
+//! memory) and the solver each velocity in four lanes; on x86_64 with AVX2 and F16C the sums convert
 //! two pairs' gradients with one instruction and run two pairs per 256-bit register, one load per
 //! neighbour's velocity; the results are the same to the bit as [`pair_sum`]'s over the converted
 //! gradients (tested).
 
 use super::half::Half4;
+
 /// Independent partial sums a neighbour-list loop keeps, so that consecutive pairs do not wait for each
 /// other's additions (one chain per dimension is bound by the adder's latency, not its throughput).
 pub const CHAINS: usize = 4;
@@ -105,21 +106,53 @@ impl<const D: usize, const W: usize> Grad<D, W> for [f32; W] {
         va: [f32; W],
         _wide: bool,
     ) -> [f32; W] {
-        pair_sum(j, g, |j, g| {
-            // SAFETY: the caller guarantees j < vel.len().
-            let vb = unsafe { vel.get_unchecked(j as usize) };
-            std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
-        })
+        // SAFETY: as the caller guarantees.
+        unsafe { plain_divergence::<D, W, Self>(j, g, vel, va) }
     }
 
     #[inline(always)]
     unsafe fn push(j: &[u32], g: &[Self], k: &[f32], ka: f32, _wide: bool) -> [f32; W] {
-        pair_sum(j, g, |j, g| {
-            // SAFETY: the caller guarantees j < k.len().
-            let s = ka + unsafe { k.get_unchecked(j as usize) };
-            std::array::from_fn(|d| s * g[d])
-        })
+        // SAFETY: as the caller guarantees.
+        unsafe { plain_push::<D, W, Self>(j, g, k, ka) }
     }
+}
+
+/// [`Grad::divergence`] by the generic loop over the records' f32 lanes (what every path must equal).
+///
+/// # Safety
+/// Every index in `j` is below `vel.len()`.
+#[inline(always)]
+unsafe fn plain_divergence<const D: usize, const W: usize, R: Grad<D, W>>(
+    j: &[u32],
+    g: &[R],
+    vel: &[[f32; W]],
+    va: [f32; W],
+) -> [f32; W] {
+    pair_sum(j, g, |j, g| {
+        // SAFETY: the caller guarantees j < vel.len().
+        let vb = unsafe { vel.get_unchecked(j as usize) };
+        let g = g.lanes();
+        std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
+    })
+}
+
+/// [`Grad::push`] by the generic loop over the records' f32 lanes.
+///
+/// # Safety
+/// Every index in `j` is below `k.len()`.
+#[inline(always)]
+unsafe fn plain_push<const D: usize, const W: usize, R: Grad<D, W>>(
+    j: &[u32],
+    g: &[R],
+    k: &[f32],
+    ka: f32,
+) -> [f32; W] {
+    pair_sum(j, g, |j, g| {
+        // SAFETY: the caller guarantees j < k.len().
+        let s = ka + unsafe { k.get_unchecked(j as usize) };
+        let g = g.lanes();
+        std::array::from_fn(|d| s * g[d])
+    })
 }
 
 /// Gradients × h⁴ in binary16 (D ≤ 3 lanes of four): the 3D lists' records.
@@ -155,12 +188,8 @@ impl<const D: usize> Grad<D, 4> for Half4 {
             return unsafe { avx::divergence(j, g, vel, va) };
         }
         let _ = wide;
-        pair_sum(j, g, |j, g| {
-            // SAFETY: the caller guarantees j < vel.len().
-            let vb = unsafe { vel.get_unchecked(j as usize) };
-            let g = g.unpack();
-            std::array::from_fn(|d| (va[d] - vb[d]) * g[d])
-        })
+        // SAFETY: as the caller guarantees.
+        unsafe { plain_divergence::<D, 4, Self>(j, g, vel, va) }
     }
 
     #[inline(always)]
@@ -171,12 +200,8 @@ impl<const D: usize> Grad<D, 4> for Half4 {
             return unsafe { avx::push(j, g, k, ka) };
         }
         let _ = wide;
-        pair_sum(j, g, |j, g| {
-            // SAFETY: the caller guarantees j < k.len().
-            let s = ka + unsafe { k.get_unchecked(j as usize) };
-            let g = g.unpack();
-            std::array::from_fn(|d| s * g[d])
-        })
+        // SAFETY: as the caller guarantees.
+        unsafe { plain_push::<D, 4, Self>(j, g, k, ka) }
     }
 }
 
