@@ -77,7 +77,7 @@ pub enum ConfigError {
 const DOF_NAMES: &str = "x, y, z, roll, pitch, yaw";
 
 /// An opening in a floating body's walls or an internal wall (see [`sph::body::RegionSpec`]).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct OpeningCfg {
     /// m, box coordinates (origin at the centre of the box's bottom face).
@@ -87,7 +87,7 @@ pub struct OpeningCfg {
 }
 
 /// A spring holding a floating body (see [`sph::body::SpringSpec`]).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpringCfg {
     /// m, box coordinates.
@@ -102,7 +102,7 @@ pub struct SpringCfg {
 
 /// A floating body under `bodies.NAME` (see [`sph::body::BodySpec`]); openings and springs are maps by
 /// name, as ROS 2 parameters nest.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyCfg {
     pub size: [f64; 3],
@@ -167,7 +167,7 @@ impl BodyCfg {
     }
 }
 
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Probes {
     pub names: Vec<String>,
@@ -176,7 +176,7 @@ pub struct Probes {
     pub y: Vec<f64>,
 }
 
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Sensors {
     pub names: Vec<String>,
@@ -185,7 +185,7 @@ pub struct Sensors {
     pub z: Vec<f64>,
 }
 
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MotionSource {
     #[default]
@@ -196,7 +196,7 @@ pub enum MotionSource {
 }
 
 /// Per-DOF sinusoids, arrays in the order x, y, z, roll, pitch, yaw (m, rad, s).
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RegularCfg {
     pub amplitude: Vec<f64>,
@@ -205,7 +205,7 @@ pub struct RegularCfg {
 }
 
 /// Per-DOF JONSWAP sums of sines, arrays in the order x, y, z, roll, pitch, yaw.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct IrregularCfg {
     /// 2·sqrt(m0) per DOF (m or rad).
@@ -229,7 +229,7 @@ impl Default for IrregularCfg {
     }
 }
 
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MotionCfg {
     pub source: MotionSource,
@@ -252,7 +252,7 @@ fn default_duration() -> f64 {
 }
 
 /// Everything under `ros__parameters`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunConfig {
     pub dimension: usize,
@@ -327,7 +327,7 @@ pub struct RunConfig {
 
 /// The node's zero-copy services (see `crate::iox`): motion in with `input.type: iceoryx2`, outputs and
 /// particle frames out.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Iceoryx2Cfg {
     /// Service prefix: `NAME/motion`, `NAME/outputs`, `NAME/particles`.
@@ -360,7 +360,7 @@ fn default_diag_rate() -> f64 {
 }
 
 /// The node's particle cloud output.
-#[derive(Debug, Clone, Copy, Deserialize)]
+#[derive(Debug, Clone, Copy, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ParticlesCfg {
     /// Clouds per simulated second (0: off).
@@ -379,7 +379,7 @@ impl Default for ParticlesCfg {
 }
 
 /// How requests and replies of services are matched on DDS (it differs between ROS 2 middlewares).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ServiceMappingCfg {
     #[default]
@@ -389,7 +389,7 @@ pub enum ServiceMappingCfg {
 }
 
 /// Which message drives the tank in `slosh node`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum InputType {
     /// nav_msgs/Odometry on `motion/odom`.
@@ -406,7 +406,7 @@ pub enum InputType {
 }
 
 /// Motion input of the ROS 2 node.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InputCfg {
     #[serde(rename = "type")]
@@ -447,7 +447,7 @@ impl Default for InputCfg {
 }
 
 /// Where a sample's time comes from.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StampSource {
     #[default]
@@ -456,7 +456,7 @@ pub enum StampSource {
 }
 
 /// Frame names in the node's messages, and where the tank sits on the vessel.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FramesCfg {
     pub vessel: String,
@@ -475,7 +475,7 @@ impl Default for FramesCfg {
 }
 
 /// How `slosh node` paces the simulation.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RealtimeMode {
     /// Keep up with the incoming motion in wall-clock time; hold the last pose when input stops.
@@ -488,7 +488,7 @@ pub enum RealtimeMode {
     FollowClock,
 }
 
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RealtimeCfg {
     pub mode: RealtimeMode,
@@ -960,6 +960,19 @@ impl Loaded {
             },
             e => e,
         }
+    }
+
+    /// Every parameter as the run uses it, defaults included (`summary.json`'s and the recording's
+    /// `effective_parameters`; `parameters` holds only those given): the configuration with `params`'
+    /// particle spacing (a node's automatic resolution may have chosen it), the kernel gradient the scheme
+    /// takes when none is set, and the speed of sound the solver derived when none is set.
+    pub fn effective_parameters(&self, params: &SimParams) -> Value {
+        let mut v = serde_json::to_value(&self.config).expect("the configuration serialises");
+        v["particle_spacing"] = serde_json::json!(params.particle_spacing);
+        v["solver"]["kernel_gradient"] =
+            serde_json::to_value(params.solver.kernel_gradient()).expect("serialises");
+        v["solver"]["sound_speed"] = serde_json::json!(params.sound_speed());
+        v
     }
 
     /// The solver's parameters, checked.

@@ -299,7 +299,10 @@ pub struct Summary {
     /// Particle frames written (`--snapshots`): folder, series file, frames, rate and frame of reference.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub snapshots: Option<serde_json::Value>,
+    /// The parameters given (file and overrides, with the duration run).
     pub parameters: serde_json::Value,
+    /// Every parameter as run, defaults included ([`crate::config::Loaded::effective_parameters`]).
+    pub effective_parameters: serde_json::Value,
 }
 
 /// Writes `summary.json` whole or not at all (through a temporary file renamed into place: a full disk leaves

@@ -13,7 +13,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 /// What `record.*` configures.
-#[derive(Debug, Clone, serde::Deserialize)]
+#[derive(Debug, Clone, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RecordCfg {
     /// rosbag2 folder to create (empty: no recording).
@@ -152,15 +152,27 @@ impl RawMessage {
 /// The name of the MCAP metadata record that documents a recording's run.
 pub const PARAMETERS_RECORD: &str = "slosh_parameters";
 
-/// The entries of the [`PARAMETERS_RECORD`] for a run's parameters (as JSON under `parameters`).
-pub fn parameters_metadata(parameters: &serde_json::Value) -> BTreeMap<String, String> {
-    BTreeMap::from([("parameters".to_string(), parameters.to_string())])
+/// The entries of the [`PARAMETERS_RECORD`] for a run's parameters, as JSON: those given under
+/// `parameters`, every parameter as run (defaults included) under `effective_parameters`.
+pub fn parameters_metadata(
+    parameters: &serde_json::Value,
+    effective: &serde_json::Value,
+) -> BTreeMap<String, String> {
+    BTreeMap::from([
+        ("parameters".to_string(), parameters.to_string()),
+        ("effective_parameters".to_string(), effective.to_string()),
+    ])
 }
 
 impl Recorder {
     /// Creates the rosbag2 folder `cfg.path` (which must not exist yet, or be empty) and its MCAP file.
-    pub fn create(cfg: &RecordCfg, parameters: &serde_json::Value) -> Result<Self, RecordError> {
-        Self::create_with_metadata(cfg, parameters_metadata(parameters))
+    /// `parameters` and `effective` go in the [`PARAMETERS_RECORD`] ([`parameters_metadata`]).
+    pub fn create(
+        cfg: &RecordCfg,
+        parameters: &serde_json::Value,
+        effective: &serde_json::Value,
+    ) -> Result<Self, RecordError> {
+        Self::create_with_metadata(cfg, parameters_metadata(parameters, effective))
     }
 
     /// [`Recorder::create`] with the [`PARAMETERS_RECORD`]'s entries given whole.
@@ -601,7 +613,7 @@ mod tests {
             path: dir.display().to_string(),
             ..Default::default()
         };
-        let mut r = Recorder::create(&cfg, &serde_json::json!({})).unwrap();
+        let mut r = Recorder::create(&cfg, &serde_json::json!({}), &serde_json::json!({})).unwrap();
         for &t in times {
             let v = Vector3 {
                 x: t as f64,

@@ -67,7 +67,11 @@ fn facts(run: &Path) -> Facts {
     let s: Option<serde_json::Value> = std::fs::read_to_string(run.join("summary.json"))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
-    let p = s.as_ref().map(|s| &s["parameters"]);
+    // (`effective_parameters` since 2026-12-02; earlier runs' summaries have the given ones only)
+    let p = s.as_ref().map(|s| match &s["effective_parameters"] {
+        serde_json::Value::Null => &s["parameters"],
+        e => e,
+    });
     Facts {
         tank: p.and_then(|p| Some((p["tank"]["length"].as_f64()?, p["tank"]["height"].as_f64()?))),
         spacing: p.and_then(|p| p["particle_spacing"].as_f64()),

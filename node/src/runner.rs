@@ -164,8 +164,10 @@ pub fn drive(
     if let Some(p) = parameters.as_object_mut() {
         p.insert("duration".into(), duration.into());
     }
+    let mut effective = cfg.effective_parameters(&params);
+    effective["duration"] = duration.into();
     let mut record = match d.record {
-        Some((rc, f)) => Some((Recorder::create(&rc, &parameters)?, f)),
+        Some((rc, f)) => Some((Recorder::create(&rc, &parameters, &effective)?, f)),
         None => None,
     };
     let mut outputs = CsvOutputs::create(out, &params, opts.snapshots.is_some())?;
@@ -268,6 +270,7 @@ pub fn drive(
             })
         }),
         parameters,
+        effective_parameters: effective,
     };
     // A failed run's own error is the one reported (a full disk fails the summary as well).
     match (write_summary(out, &summary), &result) {

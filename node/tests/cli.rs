@@ -69,6 +69,20 @@ fn run_writes_the_documented_outputs() {
     // The case as run: --duration in place of the file's 20 s.
     assert_eq!(s["parameters"]["duration"], 0.2);
     assert_eq!(s["parameters"]["particle_spacing"], 0.02);
+    // Every parameter as run, the ones not given included: the defaults, the scheme's kernel gradient and
+    // the speed of sound the solver derived (not given: 0 in the file's terms).
+    let e = &s["effective_parameters"];
+    assert_eq!(e["duration"], 0.2);
+    assert_eq!(e["particle_spacing"], 0.02);
+    assert!(s["parameters"]["solver"]["dfsph"].is_null(), "{s}");
+    assert_eq!(e["solver"]["dfsph"]["max_density_error"], 1e-4, "{e}");
+    assert!(s["parameters"]["motion_timeout_s"].is_null(), "{s}");
+    assert!(e["motion_timeout_s"].as_f64().unwrap() > 0.0, "{e}");
+    assert_eq!(e["motion"]["irregular"]["seed"], 2);
+    assert_eq!(e["solver"]["kernel_gradient"], "exact", "{e}");
+    let c0 = e["solver"]["sound_speed"].as_f64().unwrap();
+    assert!(c0 > 10.0 && c0 < 100.0, "{c0}");
+    assert!(e["output_rate_hz"].as_f64().unwrap() > 0.0);
     assert!(s["error"].is_null());
     let _ = std::fs::remove_dir_all(&out);
 }

@@ -267,8 +267,12 @@ fn an_empty_recording_is_read_by_rosbags_and_mcap() {
         path: dir.join("bag").display().to_string(),
         ..Default::default()
     };
-    let mut r =
-        slosh_node::record::Recorder::create(&cfg, &serde_json::json!({"case": "empty"})).unwrap();
+    let mut r = slosh_node::record::Recorder::create(
+        &cfg,
+        &serde_json::json!({"case": "empty"}),
+        &serde_json::json!({"case": "empty", "gravity": 9.81}),
+    )
+    .unwrap();
     r.finish().unwrap();
     let v = common::read_bag(&dir.join("bag"));
     assert_eq!(v["rosbags"], serde_json::json!({}), "{v}");
@@ -277,5 +281,9 @@ fn an_empty_recording_is_read_by_rosbags_and_mcap() {
         .as_str()
         .unwrap()
         .contains("empty"));
+    assert!(v["metadata"]["slosh_parameters"]["effective_parameters"]
+        .as_str()
+        .unwrap()
+        .contains("9.81"));
     let _ = std::fs::remove_dir_all(&dir);
 }

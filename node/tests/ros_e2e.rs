@@ -1316,6 +1316,10 @@ fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
     let params: serde_json::Value =
         serde_json::from_str(meta["parameters"].as_str().unwrap()).unwrap();
     assert_eq!(params["particle_spacing"].as_f64(), Some(dp), "{meta}");
+    let effective: serde_json::Value =
+        serde_json::from_str(meta["effective_parameters"].as_str().unwrap()).unwrap();
+    assert_eq!(effective["particle_spacing"].as_f64(), Some(dp), "{meta}");
+    assert_eq!(effective["solver"]["scheme"], "dfsph", "{meta}");
     let chosen: serde_json::Value =
         serde_json::from_str(meta["auto_resolution"].as_str().unwrap()).unwrap();
     assert_eq!(chosen["requested_particle_spacing"].as_f64(), Some(0.01));

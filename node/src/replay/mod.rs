@@ -17,7 +17,7 @@ use slosh_msgs::builtin_interfaces::Time;
 use std::path::Path;
 
 /// What to do with a sample whose stamp repeats or goes back, that is not finite, or that jumps.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BadSamples {
     /// Stop with an error naming the message.
@@ -28,7 +28,7 @@ pub enum BadSamples {
 }
 
 /// What `replay.*` configures.
-#[derive(Debug, Clone, Default, serde::Deserialize)]
+#[derive(Debug, Clone, Default, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ReplayCfg {
     pub bad_samples: BadSamples,

@@ -6,7 +6,7 @@ use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 
 /// World frame of incoming poses.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum WorldFrame {
     /// x east, y north, z up (REP 103).
@@ -17,7 +17,7 @@ pub enum WorldFrame {
 }
 
 /// Body frame of incoming poses.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum BodyFrame {
     /// x forward, y left, z up (REP 103).
@@ -28,7 +28,7 @@ pub enum BodyFrame {
 }
 
 /// Pose of the tank frame (origin at the centre of the tank bottom) in the vessel's FLU body frame.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TankPose {
     /// m.

@@ -696,7 +696,10 @@ pub fn run(
     let mut recorder = if c.record.path.is_empty() {
         None
     } else {
-        let mut meta = crate::record::parameters_metadata(&recorded_parameters);
+        let mut meta = crate::record::parameters_metadata(
+            &recorded_parameters,
+            &cfg.effective_parameters(&params),
+        );
         if let Some(v) = &choice_record {
             meta.insert("auto_resolution".into(), v.to_string());
         }
