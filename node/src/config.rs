@@ -1114,6 +1114,16 @@ impl Loaded {
                 ),
             ));
         }
+        if !(c.record.flush_interval_s.is_finite() && c.record.flush_interval_s >= 0.0) {
+            return Err(key_err(
+                src,
+                "record.flush_interval_s",
+                format!(
+                    "must be zero (write out only full chunks) or a positive number of seconds of log time, got {}",
+                    c.record.flush_interval_s
+                ),
+            ));
+        }
         for (key, name) in [
             ("frames.tank", &c.frames.tank),
             ("frames.vessel", &c.frames.vessel),
@@ -1404,6 +1414,10 @@ mod tests {
         assert!(
             err(MIN, &["record.chunk_size=0"]).contains("record.chunk_size: must be at least 4096")
         );
+        assert!(err(MIN, &["record.flush_interval_s=-1"]).contains(
+            "record.flush_interval_s: must be zero (write out only full chunks) or a positive"
+        ));
+        assert!(err(MIN, &["record.flush_interval_s=.nan"]).contains("record.flush_interval_s"));
         assert!(err(MIN, &["frames.tank=''"])
             .contains("frames.tank: the frame's name may not be empty"));
         assert!(err(MIN, &["record.compression=lz4"])

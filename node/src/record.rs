@@ -22,6 +22,10 @@ pub struct RecordCfg {
     pub compression: String,
     /// Bytes of messages per chunk.
     pub chunk_size: u64,
+    /// Seconds of log time after which the chunk being written is closed and written out even if it is
+    /// not full, so that a process killed hard loses at most about this much of its recording
+    /// (`slosh bag repair` recovers the rest); 0: only full chunks are written out.
+    pub flush_interval_s: f64,
     /// Who chose `path` (for the error messages): `record.path`, or a command's output folder.
     #[serde(skip)]
     pub chosen_by: ChosenBy,
@@ -63,6 +67,7 @@ impl Default for RecordCfg {
             path: String::new(),
             compression: "zstd".into(),
             chunk_size: 768 * 1024,
+            flush_interval_s: 1.0,
             chosen_by: ChosenBy::RecordPath,
         }
     }
@@ -124,6 +129,9 @@ pub struct Recorder {
     sequence: u32,
     /// Added to every log time given (see [`Recorder::shift_log_times`]).
     shift_ns: i64,
+    /// `flush_interval_s` in ns (0: off), and the log time of the last chunk written out.
+    flush_ns: u64,
+    flushed_ns: Option<u64>,
 }
 
 /// A message serialized for the recording, to be written once its log time is known.
@@ -231,6 +239,8 @@ impl Recorder {
             end_ns: 0,
             sequence: 0,
             shift_ns: 0,
+            flush_ns: (cfg.flush_interval_s.max(0.0) * 1e9) as u64,
+            flushed_ns: None,
         })
     }
 
@@ -327,6 +337,12 @@ impl Recorder {
         }
         self.start_ns = Some(self.start_ns.map_or(log_time_ns, |s| s.min(log_time_ns)));
         self.end_ns = self.end_ns.max(log_time_ns);
+        // A chunk open for `flush_interval_s` of log time is written out (a hard kill loses only it).
+        let since = *self.flushed_ns.get_or_insert(log_time_ns);
+        if self.flush_ns > 0 && log_time_ns >= since.saturating_add(self.flush_ns) {
+            writer.flush().map_err(err)?;
+            self.flushed_ns = Some(log_time_ns);
+        }
         Ok(())
     }
 

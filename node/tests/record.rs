@@ -152,6 +152,64 @@ fn sigint_leaves_a_complete_bag() {
 }
 
 #[test]
+fn a_hard_kill_loses_at_most_the_flush_interval() {
+    // Default chunks (768 KiB, far more than this run writes): the recorder writes its chunk out after
+    // each second of log time (`record.flush_interval_s`), so a kill loses about a second, not all of it.
+    let dir = common::tmp("record-flush");
+    let bag = dir.join("bag");
+    let mut child = slosh()
+        .args(["run", "seed_tank_019", "--out"])
+        .arg(dir.join("out"))
+        .args(["--duration", "60"])
+        .args(ARGS)
+        .arg("--set")
+        .arg(format!("record.path={}", bag.display()))
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let last_row = |dir: &Path| {
+        std::fs::read_to_string(dir.join("out/probes.csv"))
+            .ok()
+            .and_then(|t| {
+                let line = t
+                    .lines()
+                    .rfind(|l| l.ends_with(|c: char| c.is_ascii_digit()))?;
+                line.split(',').next()?.parse::<f64>().ok()
+            })
+            .unwrap_or(0.0)
+    };
+    let start = Instant::now();
+    while last_row(&dir) < 3.2 {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "the run does not advance"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(Command::new("kill")
+        .args(["-KILL", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    child.wait().unwrap();
+    let reached = last_row(&dir);
+    let out = slosh().args(["bag", "repair"]).arg(&bag).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = common::read_bag(&dir.join("bag_repaired"));
+    let w = v["rosbags"]["/wrench"]["items"].as_array().unwrap();
+    let last = w.last().map_or(0.0, |i| i[0].as_f64().unwrap());
+    assert!(
+        last >= reached - 1.5,
+        "recovered up to t = {last} s of a run that had reached {reached} s"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn sigkill_then_repair_recovers_the_complete_chunks() {
     let dir = common::tmp("record-sigkill");
     let status = interrupted_run(&dir, "-KILL");

@@ -862,6 +862,31 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
             .any(|(l, m)| *l <= 1 && !m.contains("no motion input")),
         "diagnostics did not recover from input whose stamps stood still: {states:?}"
     );
+    // The input jumps 100 m away and stays there (a datum shift, or the vessel moved while the input was
+    // away): each sample is refused as a jump from the last accepted one, so after motion_timeout_s the
+    // node holds the last pose and says that samples come but are refused; then it follows the input
+    // afresh from where it is.
+    let mut states = Vec::new();
+    for k in 0..100 {
+        let mut m = rest_odometry(304.6 + k as f64 * 0.02);
+        m.pose.pose.position.x = 100.0;
+        let _ = odom.publish(m);
+        states.extend(watch(0.02, &mut last));
+    }
+    let refused = states.iter().position(|(l, m)| {
+        *l == 2 && m.starts_with("no usable motion input: holding the last pose")
+    });
+    assert!(
+        refused.is_some(),
+        "no ERROR naming the refused samples: {states:?}"
+    );
+    assert!(
+        states[refused.unwrap()..]
+            .iter()
+            .any(|(l, m)| *l <= 1 && (m == "running" || m.starts_with("behind real time"))),
+        "the node did not follow the input afresh: {states:?}"
+    );
+    assert!(last > 305.5, "outputs stopped at {last}");
     // SIGTERM: a clean exit, promptly.
     let pid = proc.0.id().to_string();
     assert!(Command::new("kill")

@@ -150,7 +150,15 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             body_points.push(pts);
         }
         let (g, top) = (params.gravity, params.fill.height);
-        let fill_x1 = tank.lo[0] + params.fill_length();
+        // (A liquid block against the −x wall: walls beyond its end start without pressure. A tank filled
+        // end to end: every wall layer, the +x wall's outer ones too, starts hydrostatic; until 2026-12-02
+        // those beyond its face started at ρ0, and the liquid's first force on the tank leaned 1.3 % of
+        // its weight towards −x.)
+        let fill_x1 = if params.fill_length() < params.tank.length {
+            tank.lo[0] + params.fill_length()
+        } else {
+            f64::INFINITY
+        };
         let hydro = move |x: [f64; D]| -> f64 {
             let z = x[D - 1];
             if x[0] <= fill_x1 + 0.5 * dp {

@@ -47,7 +47,11 @@ pub fn hint(
     let wrong: Vec<&String> = on_topic.iter().filter(|t| *t != expected).collect();
     if let Some(other) = wrong.first() {
         let fix = match input_type_of(other) {
-            Some(kind) => format!("set input.type: {kind} to take it, or publish {expected}"),
+            // The other input type listens on its own topic (motion/pose, ...): remapped to this one.
+            Some(kind) => format!(
+                "set input.type: {kind} and remap its topic to this one (-r motion/{kind}:={topic}) to take \
+                 it, or publish {expected}"
+            ),
             None => format!("publish {expected} there (or remap the input to a topic that has it)"),
         };
         return Some(format!(
@@ -107,7 +111,7 @@ mod tests {
         let h = hint("/motion/odom", "motion/odom", odom, &[pose]).unwrap();
         assert!(
             h.contains("of type geometry_msgs/msg/PoseStamped, not nav_msgs/msg/Odometry")
-                && h.contains("input.type: pose"),
+                && h.contains("input.type: pose and remap its topic to this one (-r motion/pose:=/motion/odom)"),
             "{h}"
         );
         let s = w("rt/motion/odom", "std_msgs::msg::dds_::String_");

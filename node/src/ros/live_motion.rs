@@ -34,6 +34,17 @@ pub enum Rejected {
     },
 }
 
+impl Rejected {
+    /// Whether the sample was refused for where it lies against the newest sample (its time or its pose),
+    /// not for what it holds: while the node holds the last pose, the newest sample is a held one.
+    pub fn against_newest(&self) -> bool {
+        matches!(
+            self,
+            Self::OutOfOrder { .. } | Self::Duplicate { .. } | Self::Jump { .. }
+        )
+    }
+}
+
 /// Plausibility limits of incoming samples.
 #[derive(Debug, Clone, Copy)]
 pub struct Limits {

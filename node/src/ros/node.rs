@@ -241,6 +241,8 @@ struct Counters {
     accepted: u64,
     rejected: u64,
     last_reject: String,
+    /// Motion samples rejected since the last accepted one.
+    rejected_in_a_row: u64,
     published: u64,
     timeouts: u64,
     /// How the particle spacing was chosen (`realtime.auto_resolution`).
@@ -249,6 +251,28 @@ struct Counters {
     input_check: String,
     /// Motion samples of the last [`RECENT_S`] (wall time taken, accepted).
     recent: std::collections::VecDeque<(f64, bool)>,
+}
+
+/// Why the node holds the last pose, `age` s after the last accepted motion sample: no input, or only
+/// rejected samples (how many, and the last reason).
+fn no_input(counters: &Counters, age: f64, timeout: f64) -> String {
+    match counters.rejected_in_a_row {
+        0 => format!("no motion input for {age:.2} s (motion_timeout_s = {timeout})"),
+        n => format!(
+            "no usable motion input for {age:.2} s (motion_timeout_s = {timeout}): the {n} samples since the last accepted one were rejected (last: {}); a newer sample that does not continue the held pose is then followed afresh",
+            counters.last_reject
+        ),
+    }
+}
+
+/// While the simulation is still behind the last accepted sample (`last_real`, simulation time), it
+/// runs on the motion received; the last pose is held only from there.
+fn buffered(last_real: f64, sim_time: f64) -> String {
+    if sim_time < last_real {
+        format!(" from t = {last_real:.3} s (the simulation, at {sim_time:.3} s, still runs on the motion received up to then)")
+    } else {
+        String::new()
+    }
 }
 
 /// The window over which a node that rejects most of its motion samples says so, s.
@@ -745,7 +769,8 @@ pub fn run(
     // Outputs at k / rate (the steps land on them), the first the state at t = 0 before any step.
     let mut next_output = 0u64;
     let mut last_diag = f64::NEG_INFINITY;
-    let mut last_warn = f64::NEG_INFINITY;
+    // Warnings are throttled to one a second each: rejected samples, and falling behind real time.
+    let (mut last_reject_warn, mut last_behind_warn) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
     // The stamp (s) of the newest accepted motion sample, and the samples rejected in a row since that look
     // like a motion on another time base.
     let mut newest_stamp: Option<f64> = None;
@@ -917,15 +942,19 @@ pub fn run(
             let gap = newest_stamp
                 .map(|n| ts - n)
                 .filter(|g| *g > c.input.max_gap_s && !holding);
+            // Err: why, and whether it was for where the sample lies against the newest (maybe held) one.
             let pushed = match gap {
-                Some(g) => Err(format!(
-                    "stamp {:.6} s is {g:.3} s after the newest sample's, more than input.max_gap_s = {}",
-                    ts - base,
-                    c.input.max_gap_s
+                Some(g) => Err((
+                    format!(
+                        "stamp {:.6} s is {g:.3} s after the newest sample's, more than input.max_gap_s = {}",
+                        ts - base,
+                        c.input.max_gap_s
+                    ),
+                    false,
                 )),
                 None => motion
                     .push(ts - base, &sample.reading, &frames)
-                    .map_err(|e| e.to_string()),
+                    .map_err(|e| (e.to_string(), e.against_newest())),
             };
             match pushed {
                 Ok(()) => {
@@ -942,6 +971,7 @@ pub fn run(
                     other_base.clear();
                     last_real = ts - base;
                     counters.accepted += 1;
+                    counters.rejected_in_a_row = 0;
                     counters.note_motion(w, true);
                     pacing.input(sample.received);
                     got = true;
@@ -950,20 +980,26 @@ pub fn run(
                         log(ros2_client::ros2::LogLevel::Info, "motion input is back");
                     }
                 }
-                // The input back after a timeout with stamps behind the held pose's (its clock stood still
-                // while it was away, or runs behind the node's): held samples are the node's own, so it
-                // follows the input's stamps at once, from the simulation's present, as after a pause.
-                Err(_)
-                    if holding
-                        && gap.is_none()
-                        && newest_stamp.is_none_or(|n| ts > n)
-                        && motion.newest().is_some_and(|n| ts - base <= n) =>
+                // The input back after a timeout (a sample newer than its last accepted one) that does not
+                // continue the held pose: its stamps behind the held ones (its clock stood still while it
+                // was away, or runs behind the node's), or its pose too far from the held one for the time
+                // between them (the vessel moved meanwhile; or every sample since the last accepted one was
+                // refused for such a jump, which the timeout then ends). Held samples are the node's own, so
+                // it follows the input at once, from the simulation's present, as after a pause.
+                Err((e, true))
+                    if holding && gap.is_none() && newest_stamp.is_none_or(|n| ts > n) =>
                 {
+                    let behind = motion.newest().unwrap_or(ts - base) - (ts - base);
                     log(
-                        ros2_client::ros2::LogLevel::Info,
+                        ros2_client::ros2::LogLevel::Warn,
                         &format!(
-                            "motion input is back, its stamps {:.3} s behind the held pose's: following them from t = {:.4} s",
-                            motion.newest().unwrap_or(ts - base) - (ts - base),
+                            "motion input is back after {:.2} s without a usable sample, but it does not continue the held pose ({}): following it afresh from t = {:.4} s",
+                            pacing.input_age(w).unwrap_or(0.0),
+                            if behind >= 0.0 {
+                                format!("its stamps are {behind:.3} s behind the held pose's")
+                            } else {
+                                e
+                            },
                             sim.time()
                         ),
                     );
@@ -973,16 +1009,25 @@ pub fn run(
                     newest_stamp = None;
                     incoming.push_front(sample);
                 }
-                Err(e) => {
+                Err((e, _)) => {
                     counters.rejected += 1;
+                    counters.rejected_in_a_row += 1;
                     counters.note_motion(w, false);
                     counters.last_reject = e.clone();
-                    if w - last_warn > 1.0 {
-                        last_warn = w;
+                    if w - last_reject_warn > 1.0 {
+                        last_reject_warn = w;
                         log(
                             ros2_client::ros2::LogLevel::Warn,
                             &format!(
-                                "rejected a motion sample: {e} (times since the first sample; its stamp is {ts:.6} s){} ({} rejected so far)",
+                                "rejected a motion sample: {e}{}{} ({} rejected so far)",
+                                // (The stamps in the reasons count from the first sample.)
+                                if e.starts_with("stamp ") {
+                                    format!(
+                                        " (times since the first sample; its stamp is {ts:.6} s)"
+                                    )
+                                } else {
+                                    String::new()
+                                },
                                 if c.input.stamp == StampSource::Header && ts == 0.0 {
                                     ": the messages' header stamps are zero (never set?): stamp them, or set input.stamp: receive"
                                 } else {
@@ -1057,8 +1102,8 @@ pub fn run(
                 if let Err(e) = pushed {
                     counters.rejected += 1;
                     counters.last_reject = format!("motion/accel: {e}");
-                    if wall() - last_warn > 1.0 {
-                        last_warn = wall();
+                    if wall() - last_reject_warn > 1.0 {
+                        last_reject_warn = wall();
                         log(
                             ros2_client::ros2::LogLevel::Warn,
                             &format!(
@@ -1132,7 +1177,11 @@ pub fn run(
                         counters.timeouts += 1;
                         log(
                             ros2_client::ros2::LogLevel::Error,
-                            &format!("no motion input for {age:.2} s (motion_timeout_s = {}): holding the last pose", c.motion_timeout_s),
+                            &format!(
+                                "{}: holding the last pose{}",
+                                no_input(&counters, age, c.motion_timeout_s),
+                                buffered(last_real, sim.time())
+                            ),
                         );
                     }
                     // Held samples follow the wall clock from the last real one, at most 100 per second.
@@ -1308,8 +1357,8 @@ pub fn run(
             // Held samples (no input) are no input to fall behind: they come in a stretch of
             // motion_timeout_s at once.
             let input_until = if holding { sim.time() } else { until };
-            if pacing.record(wall(), sim.time(), input_until) && wall() - last_warn > 1.0 {
-                last_warn = wall();
+            if pacing.record(wall(), sim.time(), input_until) && wall() - last_behind_warn > 1.0 {
+                last_behind_warn = wall();
                 log(
                     ros2_client::ros2::LogLevel::Warn,
                     &format!(
@@ -1321,10 +1370,20 @@ pub fn run(
             }
         }
         let rejecting = counters.mostly_rejected(wall());
+        let holding_state;
         let state = if paused {
             "paused (~/pause)"
         } else if holding {
-            "no motion input: holding the last pose"
+            holding_state = format!(
+                "no {}motion input: holding the last pose{}",
+                if counters.rejected_in_a_row > 0 {
+                    "usable "
+                } else {
+                    ""
+                },
+                buffered(last_real, sim.time())
+            );
+            &holding_state
         } else if pacing.behind() {
             "behind real time"
         } else if sub_clock.is_some() && ros_time.is_none() {
