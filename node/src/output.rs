@@ -207,7 +207,8 @@ impl CsvOutputs {
         let row = |c: &mut Csv, vals: &mut dyn Iterator<Item = f64>| -> std::io::Result<()> {
             let mut line = format!("{:.6}", o.time);
             for v in vals {
-                line += &format!(",{v:.6e}");
+                // (+ 0.0: a negative zero, e.g. a 2D run's fy, is written as 0.000000e0, not -0.000000e0.)
+                line += &format!(",{:.6e}", v + 0.0);
             }
             line.push('\n');
             c.append(&line)
@@ -232,7 +233,7 @@ impl CsvOutputs {
                     .chain(&b.moment)
                     .chain([&b.flooded_volume, &b.inflow_rate])
                 {
-                    lines += &format!(",{v:.6e}");
+                    lines += &format!(",{:.6e}", v + 0.0);
                 }
                 lines.push('\n');
             }

@@ -45,6 +45,9 @@ fn run_writes_the_documented_outputs() {
     );
     let (h, rows) = csv(&out.join("wrench.csv"));
     assert_eq!(h, ["time", "fx", "fy", "fz", "mx", "my", "mz"]);
+    // A 2D run has no fy, mx, mz: written as plain zeros, not negative ones.
+    let text = std::fs::read_to_string(out.join("wrench.csv")).unwrap();
+    assert!(!text.contains("-0.000000e0"), "{text}");
     // Liquid weight 0.8 x 0.25 x 0.19 x 1000 x 9.81 = 372.8 N, downwards (the first row is the initial state).
     let fz = rows.last().unwrap()[3];
     assert!((fz + 372.8).abs() < 0.05 * 372.8, "fz {fz}");

@@ -358,7 +358,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             self.impulse.moment[k] += (r.totals.moment[k] + b.total_moment[k]) * r.dt;
         }
         self.impulse_time += r.dt;
-        self.time = t + r.dt;
+        self.time = if r.dt == room { end } else { t + r.dt };
         let st = &mut self.stats;
         st.steps += 1;
         st.last_dt = r.dt;
@@ -760,9 +760,10 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         self.rates_current = false;
         let mut dt = self.time_step()?;
         let end = self.end_time(motion);
-        // The last step before the motion ends lands on its end (a shorter step is always stable).
-        if t < end && t + dt > end {
-            dt = end - t;
+        // Steps land on the end of the motion or the time `step_to` asked for, without a sliver of a step
+        // after (a shorter step is always stable).
+        if t < end {
+            dt = crate::scheme::landing::landing_step(dt, end - t);
         }
         if t + dt > end + 1e-12 {
             return Err(SimError::MotionEnded { time: t + dt, end });
@@ -809,7 +810,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 0.25 * self.params.particle_spacing,
             );
         }
-        self.time = t + dt;
+        // (Exactly on the landing time: t + (end − t) may round off it.)
+        self.time = if dt == end - t { end } else { t + dt };
         self.stats.steps += 1;
         self.stats.last_dt = dt;
         self.stats.min_dt = self.stats.min_dt.min(dt);

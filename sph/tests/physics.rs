@@ -832,3 +832,28 @@ fn dfsph_iteration_control_keeps_every_step_converged() {
     );
     assert!(controlled.max_density_error <= sph::params::DfsphSpec::default().max_density_error);
 }
+
+#[test]
+fn steps_land_on_the_requested_times_without_slivers() {
+    // Outputs every 7 ms, not a multiple of either scheme's step: the step before each lands on it, none
+    // shorter than half a step (until 2026-12-02 WCSPH cut the step that passed it, and left steps of
+    // 1e-7 s), and the time is exactly the one asked for.
+    for scheme in [Scheme::Wcsph, Scheme::Dfsph] {
+        let mut p = tank2d(0.8, 0.6, 0.39, 0.04);
+        p.solver.scheme = scheme;
+        let mut sim = sph::build(p).unwrap();
+        let mut longest: f64 = 0.0;
+        for k in 1..=30 {
+            let t = k as f64 * 0.007;
+            while sim.time() < t {
+                longest = longest.max(sim.step_to(&AtRest, t).unwrap());
+            }
+            assert_eq!(sim.time(), t, "{scheme:?}: output {k}");
+        }
+        let shortest = sim.stats().min_dt;
+        assert!(
+            shortest >= 0.3 * longest,
+            "{scheme:?}: shortest step {shortest} s against {longest} s"
+        );
+    }
+}

@@ -31,6 +31,7 @@
 
 use super::candidates::{lane_sum, share_room, wide_lanes, Room, LANES};
 use super::half::Half4;
+use super::landing::landing_step;
 use super::near::Near;
 use super::pair_sums::Grad;
 use super::warm_start::{Columns, Setting};
@@ -957,20 +958,6 @@ impl<const D: usize> Workspace<D> {
     }
 }
 
-/// The step to take when the flow allows `dt` and a time to land on is `room` ahead: `room` itself when
-/// it is within one step, half of it when within two (so no sliver is left for the step after), else `dt`.
-fn landing_step(dt: f64, room: f64) -> f64 {
-    // A relative margin, so that 0.02 s of 5 ms steps is four steps, not five.
-    let steps = (room / dt * (1.0 - 1e-9)).ceil();
-    if steps <= 1.0 {
-        room
-    } else if steps <= 2.0 {
-        0.5 * room
-    } else {
-        dt
-    }
-}
-
 fn merged(partials: &[Partial]) -> Partial {
     let mut total = Partial::default();
     for p in partials {
@@ -1468,22 +1455,6 @@ mod tests {
             viscous_walls |= wall.iter().any(|q| q.abs() > 1e-3 * vs);
         }
         assert!(viscous_walls, "approaching walls to compare");
-    }
-
-    #[test]
-    fn steps_land_without_a_sliver() {
-        // Far from the landing time: the flow's step.
-        assert_eq!(landing_step(0.005, 0.02), 0.005);
-        assert_eq!(landing_step(0.005, 0.0151), 0.005);
-        // Within two steps: half the rest each, never a sliver after.
-        assert_eq!(landing_step(0.005, 0.0099), 0.00495);
-        assert_eq!(landing_step(0.005, 0.0051), 0.00255);
-        // Within one step (four 5 ms steps fill 20 ms exactly, whatever the rounding): the rest.
-        assert_eq!(
-            landing_step(0.005, 0.005 * (1.0 + 1e-12)),
-            0.005 * (1.0 + 1e-12)
-        );
-        assert_eq!(landing_step(0.005, 0.004), 0.004);
     }
 
     #[test]

@@ -4,6 +4,7 @@
 pub mod candidates;
 pub mod dfsph;
 pub mod half;
+pub mod landing;
 pub mod near;
 pub mod pair_sums;
 pub mod warm_start;
