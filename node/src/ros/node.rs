@@ -768,7 +768,10 @@ pub fn run(
     let rate = c.output_rate_hz;
     // Outputs at k / rate (the steps land on them), the first the state at t = 0 before any step.
     let mut next_output = 0u64;
-    let mut last_diag = f64::NEG_INFINITY;
+    let mut last_diag = DiagClock {
+        wall: f64::NEG_INFINITY,
+        level: None,
+    };
     // Warnings are throttled to one a second each: rejected samples, and falling behind real time.
     let (mut last_reject_warn, mut last_behind_warn) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
     // The stamp (s) of the newest accepted motion sample, and the samples rejected in a row since that look
@@ -1143,6 +1146,7 @@ pub fn run(
                 wall(),
                 &mut last_diag,
                 c.diagnostics_rate_hz,
+                level_of("waiting for motion input", false, &counters),
                 || {
                     diagnostics(
                         &full_name,
@@ -1337,7 +1341,7 @@ pub fn run(
                     next_output = (t * rate + 1e-9).floor() as u64 + 1;
                 }
                 // Keep reading input and reporting while a long stretch is stepped.
-                if wall() - last_diag > 1.0 / c.diagnostics_rate_hz {
+                if wall() - last_diag.wall > 1.0 / c.diagnostics_rate_hz {
                     break;
                 }
             }
@@ -1399,6 +1403,7 @@ pub fn run(
             w,
             &mut last_diag,
             c.diagnostics_rate_hz,
+            level_of(state, true, &counters),
             || {
                 diagnostics(
                     &full_name,
@@ -1471,19 +1476,39 @@ pub fn run(
     Ok(())
 }
 
-/// Publishes diagnostics if their period has passed, and records them once they carry a simulation time.
+/// When diagnostics were last published, and at what level.
+struct DiagClock {
+    wall: f64,
+    level: Option<u8>,
+}
+
+impl DiagClock {
+    /// Whether diagnostics at `level` are due at wall time `wall`: their period has passed, or the level
+    /// changed since the last ones (an ERROR that lasts less than a period, e.g. a held pose the input
+    /// soon takes over from, is still published, and so is the recovery from it).
+    fn due(&self, wall: f64, rate: f64, level: u8) -> bool {
+        wall - self.wall >= 1.0 / rate || self.level != Some(level)
+    }
+}
+
+/// Publishes diagnostics at `level` if they are due (see [`DiagClock::due`]), and records them once they
+/// carry a simulation time.
 #[allow(clippy::too_many_arguments)]
 fn maybe_diagnostics(
     p: &Publisher<DiagnosticArray>,
     rec: Option<(&mut Recorder, &str)>,
     name: &str,
     wall: f64,
-    last: &mut f64,
+    last: &mut DiagClock,
     rate: f64,
+    level: u8,
     make: impl FnOnce() -> DiagnosticArray,
 ) -> Result<(), crate::record::RecordError> {
-    if wall - *last >= 1.0 / rate {
-        *last = wall;
+    if last.due(wall, rate, level) {
+        *last = DiagClock {
+            wall,
+            level: Some(level),
+        };
         let d = make();
         if let Some((r, topic)) = rec {
             if d.header.stamp.as_nanos() > 0 {
@@ -1497,6 +1522,23 @@ fn maybe_diagnostics(
     Ok(())
 }
 
+/// The diagnostics' level for the node's `state` (before the simulation has a time: `timed` false).
+fn level_of(state: &str, timed: bool, c: &Counters) -> u8 {
+    if state == "running" && !c.input_check.starts_with("input check") {
+        DiagnosticStatus::OK
+    } else if state.starts_with("running")
+        || !timed
+        || state.starts_with("behind")
+        || state.starts_with("paused")
+        || state.starts_with("waiting")
+    {
+        DiagnosticStatus::WARN
+    } else {
+        // No motion input (holding the last pose), or the solver stopped.
+        DiagnosticStatus::ERROR
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn diagnostics(
     name: &str,
@@ -1508,19 +1550,7 @@ fn diagnostics(
     wall: f64,
 ) -> DiagnosticArray {
     let (counts, stats) = (sim.counts(), sim.stats());
-    let level = if state == "running" && !c.input_check.starts_with("input check") {
-        DiagnosticStatus::OK
-    } else if state.starts_with("running")
-        || stamp.is_none()
-        || state.starts_with("behind")
-        || state.starts_with("paused")
-        || state.starts_with("waiting")
-    {
-        DiagnosticStatus::WARN
-    } else {
-        // No motion input (holding the last pose), or the solver stopped.
-        DiagnosticStatus::ERROR
-    };
+    let level = level_of(state, stamp.is_some(), c);
     let kv = |k: &str, v: String| KeyValue {
         key: k.to_string(),
         value: v,
@@ -1579,7 +1609,22 @@ fn diagnostics(
 
 #[cfg(test)]
 mod tests {
-    use super::{Counters, Reminder};
+    use super::{Counters, DiagClock, Reminder};
+    use slosh_msgs::diagnostic_msgs::DiagnosticStatus;
+
+    #[test]
+    fn diagnostics_come_at_their_rate_and_at_once_when_the_level_changes() {
+        let last = DiagClock {
+            wall: 10.0,
+            level: Some(DiagnosticStatus::OK),
+        };
+        // At 10 Hz: not within 0.1 s at the same level, due after it.
+        assert!(!last.due(10.05, 10.0, DiagnosticStatus::OK));
+        assert!(last.due(10.11, 10.0, DiagnosticStatus::OK));
+        // A change of level is due at once (an ERROR shorter than the period is not missed).
+        assert!(last.due(10.01, 10.0, DiagnosticStatus::ERROR));
+        assert!(last.due(10.01, 10.0, DiagnosticStatus::WARN));
+    }
 
     #[test]
     fn a_node_rejecting_most_of_its_motion_says_so() {

@@ -76,13 +76,19 @@ pub fn tmp(name: &str) -> PathBuf {
 /// A small 2D case (the seed tank's 0.19 m fill at dp = 20 mm) for the ROS 2 tests, for every node (`/**`);
 /// `extra` is appended to its parameters (indented by four spaces).
 pub fn small_case(extra: &str) -> String {
+    small_case_at(0.02, extra)
+}
+
+/// [`small_case`] at particle spacing `dp` (0.04: 100 liquid particles, several times faster than real
+/// time on a slow 2-core machine, for tests that follow the node in real time).
+pub fn small_case_at(dp: f64, extra: &str) -> String {
     format!(
         "/**:
   ros__parameters:
     dimension: 2
     tank: {{length: 0.8, breadth: 0.25, height: 0.6}}
     fill_height: 0.19
-    particle_spacing: 0.02
+    particle_spacing: {dp}
     probes: {{names: [left, mid], x: [-0.375, 0.0], y: [0.0, 0.0]}}
     output_rate_hz: 20.0
 {extra}"
