@@ -32,6 +32,14 @@ pub const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../launch-configs/spheric10.yaml"),
     ),
     (
+        "akyildiz2006_pitch",
+        include_str!("../../launch-configs/akyildiz2006_pitch.yaml"),
+    ),
+    (
+        "bouscasse2013_shallow",
+        include_str!("../../launch-configs/bouscasse2013_shallow.yaml"),
+    ),
+    (
         "flooding_case_a",
         include_str!("../../launch-configs/flooding_case_a.yaml"),
     ),
