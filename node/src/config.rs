@@ -40,6 +40,10 @@ pub const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../launch-configs/bouscasse2013_shallow.yaml"),
     ),
     (
+        "kleefsman2005_dambreak",
+        include_str!("../../launch-configs/kleefsman2005_dambreak.yaml"),
+    ),
+    (
         "flooding_case_a",
         include_str!("../../launch-configs/flooding_case_a.yaml"),
     ),
@@ -288,6 +292,10 @@ pub struct RunConfig {
     /// A piston wave maker at the tank's −x end.
     #[serde(default)]
     pub wave_maker: Option<sph::body::PistonSpec>,
+    /// Fixed obstacles by name: solid boxes of wall particles fixed to the tank, centre and size in the tank
+    /// frame (origin at the centre of the tank bottom).
+    #[serde(default)]
+    pub obstacles: std::collections::BTreeMap<String, OpeningCfg>,
     /// Rows per simulated second in the outputs.
     #[serde(default = "default_rate")]
     pub output_rate_hz: f64,
@@ -1056,6 +1064,7 @@ impl Loaded {
             pressure_sensors: sensors,
             bodies,
             wave_maker: c.wave_maker.clone(),
+            obstacles: regions(&c.obstacles),
         };
         p.validate()
             .map_err(|e| key_err(src, &e.field, e.message))?;
@@ -1645,6 +1654,25 @@ mod tests {
             e.contains(
                 "motion.regular.amplitude: expected 6 values (x, y, z, roll, pitch, yaw), got 2"
             ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn obstacles_are_read_by_name_and_a_bad_one_is_named() {
+        let l = load("kleefsman2005_dambreak", &[]).unwrap();
+        let p = l.sim_params().unwrap();
+        assert_eq!(p.obstacles.len(), 1);
+        assert_eq!(p.obstacles[0].name, "box");
+        assert_eq!(p.obstacles[0].size, [0.161, 0.403, 0.161]);
+        let l = load(
+            "kleefsman2005_dambreak",
+            &["obstacles.box.size=[0.01, 0.403, 0.161]".into()],
+        )
+        .unwrap();
+        let e = l.sim_params().unwrap_err().to_string();
+        assert!(
+            e.contains("obstacles.box.size") && e.contains("thinner than the kernel support"),
             "{e}"
         );
     }

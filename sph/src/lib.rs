@@ -20,6 +20,7 @@
 //!     pressure_sensors: vec![],
 //!     bodies: vec![],
 //!     wave_maker: None,
+//!     obstacles: vec![],
 //! };
 //! let mut sim = build(params).unwrap();
 //! sim.advance_to(&AtRest, 0.01).unwrap();

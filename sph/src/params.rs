@@ -303,6 +303,10 @@ pub struct SimParams {
     /// A piston wave maker at the tank's −x end.
     #[serde(default)]
     pub wave_maker: Option<crate::body::PistonSpec>,
+    /// Fixed obstacles: solid boxes of wall particles fixed to the tank (a block on the floor, a baffle), by
+    /// centre and size in the tank frame (origin at the centre of the tank bottom).
+    #[serde(default)]
+    pub obstacles: Vec<crate::body::RegionSpec>,
 }
 
 /// A parameter that cannot be used, with the field's dotted name and what would be accepted.
@@ -422,6 +426,77 @@ impl SimParams {
 
     /// Floating bodies need wall particle layers (and with WCSPH its symplectic integrator), each checked
     /// against the tank.
+    /// Obstacles lie within the tank, are at least a kernel support thick (the liquid must not see through
+    /// them) and are made of wall particles (the dynamic boundary).
+    fn validate_obstacles(&self) -> Result<(), ParamError> {
+        let Some(first) = self.obstacles.first() else {
+            return Ok(());
+        };
+        if self.solver.boundary.method != BoundaryMethod::Dynamic {
+            return Err(err(
+                &format!("obstacles.{}", first.name),
+                "obstacles are made of wall particles: set solver.boundary.method: dynamic",
+            ));
+        }
+        let support = 2.0 * self.h();
+        let lo = [-self.tank.length / 2.0, -self.tank.breadth / 2.0, 0.0];
+        let hi = [
+            self.tank.length / 2.0,
+            self.tank.breadth / 2.0,
+            self.tank.height,
+        ];
+        let axes: &[usize] = if self.dimension == 2 {
+            &[0, 2]
+        } else {
+            &[0, 1, 2]
+        };
+        for (i, o) in self.obstacles.iter().enumerate() {
+            let f = |field: &str| format!("obstacles.{}.{field}", o.name);
+            if o.name.is_empty() || self.obstacles[..i].iter().any(|p| p.name == o.name) {
+                return Err(err(
+                    "obstacles",
+                    format!(
+                        "obstacle names must be unique and not empty; got `{}`",
+                        o.name
+                    ),
+                ));
+            }
+            for (field, v) in [("centre", &o.centre), ("size", &o.size)] {
+                if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(err(
+                        &f(field),
+                        format!("element {k} is not a finite number"),
+                    ));
+                }
+            }
+            for &k in axes {
+                if !(o.size[k] >= support) {
+                    return Err(err(
+                        &f("size"),
+                        format!(
+                            "element {k} ({} m) is thinner than the kernel support {support:.4} m: the liquid \
+                             would see through the obstacle; make it at least that (or use a smaller \
+                             particle_spacing)",
+                            o.size[k]
+                        ),
+                    ));
+                }
+                let (a, b) = (o.centre[k] - 0.5 * o.size[k], o.centre[k] + 0.5 * o.size[k]);
+                if a < lo[k] - 1e-9 || b > hi[k] + 1e-9 {
+                    return Err(err(
+                        &f("centre"),
+                        format!(
+                            "the box reaches outside the tank (axis {k}: {a:.4}..{b:.4} m, tank {:.4}..{:.4} m; \
+                             the tank frame's origin is the centre of the tank bottom)",
+                            lo[k], hi[k]
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn validate_bodies(&self) -> Result<(), ParamError> {
         if let (Some(wm), Some((thickness, _))) = (&self.wave_maker, self.wave_maker_plate()) {
             wm.validate(self.tank.length, thickness, self.particle_spacing)?;
@@ -639,6 +714,7 @@ impl SimParams {
         )?;
         non_negative("solver.density_diffusion.delta", s.density_diffusion.delta)?;
         self.validate_bodies()?;
+        self.validate_obstacles()?;
         non_negative("solver.dt_min", s.dt_min)?;
         positive("solver.dt_max", s.dt_max)?;
         if s.verlet_reset_steps == 0 {

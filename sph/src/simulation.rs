@@ -149,6 +149,13 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             bodies.list.push(RigidBody::driven("wave_maker", wm, &pts));
             body_points.push(pts);
         }
+        // Fixed obstacles: the liquid starts where they and half a spacing around them hold none.
+        points.retain(|x| {
+            !params
+                .obstacles
+                .iter()
+                .any(|o| crate::tank::in_obstacle(o, *x, 0.499 * dp))
+        });
         let (g, top) = (params.gravity, params.fill.height);
         // (A liquid block against the −x wall: walls beyond its end start without pressure. A tank filled
         // end to end: every wall layer, the +x wall's outer ones too, starts hydrostatic; until 2026-12-02
@@ -170,7 +177,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let mut fluid = Fluid::new(&points, hydro);
         let m_fluid = rho0 * volume;
 
-        let (wall_pts, wall_volume) = wall_lattice::<D>(&params, layers);
+        let (mut wall_pts, wall_volume) = wall_lattice::<D>(&params, layers);
+        wall_pts.extend(crate::tank::obstacle_lattice::<D>(&params));
         let mut scratch = SortScratch::default();
         let mut bound = match params.solver.boundary.method {
             BoundaryMethod::Dynamic => dynamic::build(&wall_pts, hydro, &eos),
@@ -207,9 +215,13 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 params.bodies.iter().any(|b| {
                     let p = std::array::from_fn(|k| x[k] - b.position[k]);
                     shell::covers(b, D, p, support)
-                }) || params.wave_maker_plate().is_some_and(|(_, face)| {
-                    x[0] < face + support + params.wave_maker.as_ref().map_or(0.0, |w| w.stroke)
-                })
+                }) || params
+                    .obstacles
+                    .iter()
+                    .any(|o| crate::tank::in_obstacle::<3>(o, x, support))
+                    || params.wave_maker_plate().is_some_and(|(_, face)| {
+                        x[0] < face + support + params.wave_maker.as_ref().map_or(0.0, |w| w.stroke)
+                    })
             };
             rest_density(&kernel, &fluid, &bound, m_fluid as f32, m_bound, near_body) as f32
         };

@@ -112,6 +112,38 @@ pub fn wall_lattice<const D: usize>(p: &SimParams, layers: u32) -> (Vec<[f64; D]
     (out, volume)
 }
 
+/// Whether `x` (tank frame) lies within the obstacle box grown by `margin` on every side (in 2D along x and z).
+pub fn in_obstacle<const D: usize>(o: &crate::body::RegionSpec, x: [f64; D], margin: f64) -> bool {
+    let x = to3(x);
+    let axes: &[usize] = if D == 2 { &[0, 2] } else { &[0, 1, 2] };
+    axes.iter()
+        .all(|&k| (x[k] - o.centre[k]).abs() < 0.5 * o.size[k] + margin)
+}
+
+/// The points of the tank's wall lattice (the inside continued, so they line up with the wall layers) that
+/// fill the obstacles: solid blocks of wall particles fixed to the tank.
+pub fn obstacle_lattice<const D: usize>(p: &SimParams) -> Vec<[f64; D]> {
+    if p.obstacles.is_empty() {
+        return vec![];
+    }
+    let dp = p.particle_spacing;
+    let tank = TankBox::<D>::new(p);
+    let ax: Vec<(usize, f64)> = (0..D).map(|k| axis(tank.hi[k] - tank.lo[k], dp)).collect();
+    let total: usize = ax.iter().map(|a| a.0).product();
+    (0..total)
+        .map(|i| {
+            let mut rest = i;
+            std::array::from_fn(|k| {
+                let (n, s) = ax[k];
+                let x = tank.lo[k] + ((rest % n) as f64 + 0.5) * s;
+                rest /= n;
+                x
+            })
+        })
+        .filter(|x| p.obstacles.iter().any(|o| in_obstacle(o, *x, 0.0)))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -137,6 +169,7 @@ mod tests {
             pressure_sensors: vec![],
             bodies: vec![],
             wave_maker: None,
+            obstacles: vec![],
         }
     }
 

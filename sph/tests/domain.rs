@@ -96,12 +96,21 @@ fn run(p: &SimParams, ranks: usize) -> (Vec<Observation>, Liquid, u64) {
 
 #[test]
 fn ranks_as_threads_reproduce_one_process() {
-    for (scheme, method) in [
-        (Scheme::Wcsph, BoundaryMethod::Dynamic),
-        (Scheme::Wcsph, BoundaryMethod::Mirror),
-        (Scheme::Dfsph, BoundaryMethod::Dynamic),
+    for (scheme, method, obstacle) in [
+        (Scheme::Wcsph, BoundaryMethod::Dynamic, false),
+        (Scheme::Wcsph, BoundaryMethod::Mirror, false),
+        (Scheme::Dfsph, BoundaryMethod::Dynamic, false),
+        // A block fixed to the floor across the middle cut: its wall particles on every rank.
+        (Scheme::Dfsph, BoundaryMethod::Dynamic, true),
     ] {
-        let p = case(scheme, method);
+        let mut p = case(scheme, method);
+        if obstacle {
+            p.obstacles = vec![sph::body::RegionSpec {
+                name: "block".into(),
+                centre: [0.05, 0.0, 0.05],
+                size: [0.1, 0.25, 0.1],
+            }];
+        }
         let (o1, l1, _) = run(&p, 0);
         assert!(l1.len() > 400);
         // The liquid must move across the cuts for this to test anything.
@@ -113,7 +122,7 @@ fn ranks_as_threads_reproduce_one_process() {
         );
         for ranks in [2, 3] {
             let (o, l, rebalances) = run(&p, ranks);
-            let what = format!("{scheme:?} {method:?} on {ranks} ranks");
+            let what = format!("{scheme:?} {method:?} (obstacle: {obstacle}) on {ranks} ranks");
             assert_eq!(l, l1, "{what}: the liquid differs");
             assert_eq!(o.len(), o1.len());
             for (a, b) in o.iter().zip(&o1) {

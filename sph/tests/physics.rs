@@ -857,3 +857,114 @@ fn steps_land_on_the_requested_times_without_slivers() {
         );
     }
 }
+
+/// A block fixed to the floor in the middle of a 2D tank at rest (`obstacles`), with each scheme: the liquid
+/// starts outside it and stays out, its surface is level at the fill height on either side and above it
+/// (the block displaces exactly the liquid left out), and the tank, block included, carries the liquid's
+/// weight straight down.
+#[test]
+fn an_obstacle_on_the_floor_holds_the_liquid_at_rest_and_carries_its_weight() {
+    let (dp, fill) = (0.01, 0.15);
+    let block = sph::body::RegionSpec {
+        name: "block".into(),
+        centre: [0.0, 0.0, 0.04],
+        size: [0.1, 0.25, 0.08],
+    };
+    for scheme in [Scheme::Wcsph, Scheme::Dfsph] {
+        let mut p = tank2d(0.4, 0.3, fill, dp);
+        p.solver.scheme = scheme;
+        p.solver.boundary.method = BoundaryMethod::Dynamic;
+        p.obstacles = vec![block.clone()];
+        p.probes = vec![
+            probe("left", -0.15),
+            probe("over", 0.0),
+            probe("right", 0.15),
+        ];
+        let mut sim = sph::build(p.clone()).unwrap();
+        // Liquid mass: the fill block less the block's section, over the tank's breadth.
+        let want = 1000.0 * (0.4 * fill - 0.1 * 0.08) * p.tank.breadth;
+        let mass = sim.liquid_mass();
+        assert!(
+            (mass - want).abs() < 0.01 * want,
+            "{scheme:?}: liquid mass {mass} kg, fill less the block {want}"
+        );
+        let inside = |sim: &dyn Solver| {
+            sim.fluid_positions()
+                .iter()
+                .filter(|x| x[0].abs() < 0.05 - 0.5 * dp && x[2] < 0.08 - 0.5 * dp)
+                .count()
+        };
+        assert_eq!(
+            inside(sim.as_ref()),
+            0,
+            "{scheme:?}: liquid inside the block at the start"
+        );
+        let o = run_and_average(sim.as_mut(), &AtRest, 0.6, 1.0, 0.02);
+        eprintln!(
+            "obstacle at rest ({scheme:?}): probes {:?} m (fill {fill}), force {:?} N, weight {} N",
+            o.probes,
+            o.wrench.force,
+            mass * G
+        );
+        assert_eq!(
+            inside(sim.as_ref()),
+            0,
+            "{scheme:?}: liquid got into the block"
+        );
+        for (v, s) in o.probes.iter().zip(&p.probes) {
+            assert!(
+                (v - fill).abs() < 0.5 * dp,
+                "{scheme:?}: probe {} reads {v}, fill {fill}",
+                s.name
+            );
+        }
+        let weight = mass * G;
+        assert!(
+            (o.wrench.force[2] + weight).abs() < 0.01 * weight,
+            "{scheme:?}: vertical force {} vs weight {weight}",
+            o.wrench.force[2]
+        );
+        assert!(
+            o.wrench.force[0].abs() < 0.005 * weight,
+            "{scheme:?}: horizontal force {}",
+            o.wrench.force[0]
+        );
+        assert_eq!(sim.counts().lost, 0);
+    }
+}
+
+/// Obstacles that would not work are refused by name: thinner than the kernel support, reaching outside the
+/// tank, or with mirror walls (they are made of wall particles).
+#[test]
+fn obstacles_that_would_not_work_are_refused_by_name() {
+    let base = sph::body::RegionSpec {
+        name: "block".into(),
+        centre: [0.0, 0.0, 0.04],
+        size: [0.1, 0.25, 0.08],
+    };
+    let refused = |o: sph::body::RegionSpec, method: BoundaryMethod| {
+        let mut p = tank2d(0.4, 0.3, 0.15, 0.01);
+        p.solver.boundary.method = method;
+        p.obstacles = vec![o];
+        sph::build(p).err().expect("refused").to_string()
+    };
+    let mut thin = base.clone();
+    thin.size[0] = 0.01;
+    let e = refused(thin, BoundaryMethod::Dynamic);
+    assert!(
+        e.contains("obstacles.block.size") && e.contains("kernel support"),
+        "{e}"
+    );
+    let mut out = base.clone();
+    out.centre[2] = 0.0;
+    let e = refused(out, BoundaryMethod::Dynamic);
+    assert!(
+        e.contains("obstacles.block.centre") && e.contains("outside the tank"),
+        "{e}"
+    );
+    let e = refused(base, BoundaryMethod::Mirror);
+    assert!(
+        e.contains("obstacles.block") && e.contains("method: dynamic"),
+        "{e}"
+    );
+}

@@ -589,3 +589,77 @@ fn bouscasse_2013(overrides: &[&str], name: &str, label: &str) {
     assert!(corr > 0.9, "correlation with the record {corr}");
     assert!((0.75..1.25).contains(&ratio), "rms ratio {ratio}");
 }
+
+/// SPHERIC Test 2 (Kleefsman et al. 2005): the 3D dam break onto a box fixed to the floor (`obstacles`), with
+/// the case's incompressible scheme at 40 mm, 0-6 s: the water heights H1-H4 against the record, each in
+/// shape (correlation > 0.85) and size (rms within 25 %), and the front's arrival at H1, H2 (0.5 and 1.0 m
+/// from the column) within 0.05 s and at H3 (1.5 m, beyond the box) within 0.15 s of the measured one.
+#[test]
+fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
+    let rows = table(&read("kleefsman_spheric2/test_case_2_exp_data.dat"));
+    assert!(rows.len() > 7000, "expected the 7395 rows");
+    let t_end = 6.0;
+    let obs = observe(
+        "kleefsman2005_dambreak",
+        &[],
+        &sph::motion::AtRest,
+        t_end,
+        0.01,
+    );
+    let t: Vec<f64> = obs.iter().map(|o| o.time).collect();
+    let exp: Vec<&Vec<f64>> = rows.iter().filter(|r| r[0] <= t_end).collect();
+    let te: Vec<f64> = exp.iter().map(|r| r[0]).collect();
+    let mut panels = vec![];
+    let mut checks = vec![];
+    for (k, name) in ["H1", "H2", "H3", "H4"].iter().enumerate() {
+        let he: Vec<f64> = exp.iter().map(|r| r[9 + k]).collect();
+        let hs: Vec<f64> = obs.iter().map(|o| o.probes[k]).collect();
+        let at: Vec<f64> = te.iter().map(|&x| interp(&t, &hs, x)).collect();
+        let corr = correlation(&at, &he);
+        let std = |v: &[f64]| {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+        };
+        let ratio = std(&at) / std(&he);
+        // The front's arrival: the first time the height passes 5 cm (H4, in the reservoir: falls below 0.5 m).
+        let arrival = |ts: &[f64], h: &[f64]| {
+            let i = h
+                .iter()
+                .position(|&v| if k == 3 { v < 0.5 } else { v > 0.05 })
+                .unwrap_or_else(|| panic!("{name}: the front never arrives"));
+            ts[i]
+        };
+        let (a_sim, a_exp) = (arrival(&t, &hs), arrival(&te, &he));
+        eprintln!(
+            "Kleefsman 2005 (DFSPH, dp 40 mm) {name}: correlation {corr:.3}, rms {:.3} m against {:.3} m, peak {:.3} m against {:.3} m, front at {a_sim:.3} s against {a_exp:.3} s",
+            std(&at),
+            std(&he),
+            hs.iter().cloned().fold(0.0, f64::max),
+            he.iter().cloned().fold(0.0, f64::max)
+        );
+        panels.push(Panel {
+            title: format!("{name}"),
+            y_label: "water height (m)".into(),
+            series: vec![
+                series("slosh (DFSPH, dp 40 mm)", &t, &hs, false),
+                series("measured (MARIN, SPHERIC Test 2)", &te, &he, true),
+            ],
+            level: None,
+        });
+        let tol = if k == 2 { 0.15 } else { 0.05 };
+        checks.push((name.to_string(), corr, ratio, a_sim - a_exp, tol));
+    }
+    figure_panels(
+        "kleefsman2005_dambreak_dfsph",
+        "SPHERIC Test 2 (Kleefsman et al. 2005): 3D dam break onto a box, water heights",
+        panels,
+    );
+    for (name, corr, ratio, late, tol) in checks {
+        assert!(corr > 0.85, "{name}: correlation {corr}");
+        assert!((ratio - 1.0).abs() < 0.25, "{name}: rms ratio {ratio}");
+        assert!(
+            late.abs() < tol,
+            "{name}: front {late} s after the measured one (within {tol})"
+        );
+    }
+}

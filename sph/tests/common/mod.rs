@@ -27,6 +27,7 @@ pub fn tank2d(length: f64, height: f64, fill: f64, dp: f64) -> SimParams {
         pressure_sensors: vec![],
         bodies: vec![],
         wave_maker: None,
+        obstacles: vec![],
     }
 }
 
