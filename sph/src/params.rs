@@ -426,6 +426,15 @@ impl SimParams {
 
     /// Floating bodies need wall particle layers (and with WCSPH its symplectic integrator), each checked
     /// against the tank.
+    /// The tank's inside in x, y, z (tank frame: origin at the centre of the bottom), lower and upper corner.
+    fn tank_inside(&self) -> ([f64; 3], [f64; 3]) {
+        let t = &self.tank;
+        (
+            [-t.length / 2.0, -t.breadth / 2.0, 0.0],
+            [t.length / 2.0, t.breadth / 2.0, t.height],
+        )
+    }
+
     /// Obstacles lie within the tank, are at least a kernel support thick (the liquid must not see through
     /// them) and are made of wall particles (the dynamic boundary).
     fn validate_obstacles(&self) -> Result<(), ParamError> {
@@ -439,12 +448,7 @@ impl SimParams {
             ));
         }
         let support = 2.0 * self.h();
-        let lo = [-self.tank.length / 2.0, -self.tank.breadth / 2.0, 0.0];
-        let hi = [
-            self.tank.length / 2.0,
-            self.tank.breadth / 2.0,
-            self.tank.height,
-        ];
+        let (lo, hi) = self.tank_inside();
         let axes: &[usize] = if self.dimension == 2 {
             &[0, 2]
         } else {
@@ -517,12 +521,7 @@ impl SimParams {
             ));
         }
         let support = 2.0 * self.h();
-        let lo = [-self.tank.length / 2.0, -self.tank.breadth / 2.0, 0.0];
-        let hi = [
-            self.tank.length / 2.0,
-            self.tank.breadth / 2.0,
-            self.tank.height,
-        ];
+        let (lo, hi) = self.tank_inside();
         for (i, b) in self.bodies.iter().enumerate() {
             let ok = b.name.starts_with(|c: char| c.is_ascii_alphabetic())
                 && b.name

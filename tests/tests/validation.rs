@@ -204,15 +204,7 @@ fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str) {
     let pts: Vec<&Vec<f64>> = exp.iter().filter(|r| r[0] <= t_end).collect();
     let sim_at: Vec<f64> = pts.iter().map(|r| interp(&t, &eta, r[0])).collect();
     let meas: Vec<f64> = pts.iter().map(|r| r[1]).collect();
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    let (ms, me) = (mean(&sim_at), mean(&meas));
-    let cov: f64 = sim_at
-        .iter()
-        .zip(&meas)
-        .map(|(a, b)| (a - ms) * (b - me))
-        .sum();
-    let var = |v: &[f64], m: f64| v.iter().map(|a| (a - m).powi(2)).sum::<f64>();
-    let corr = cov / (var(&sim_at, ms) * var(&meas, me)).sqrt();
+    let corr = correlation(&sim_at, &meas);
     let ratio = rms(&sim_at) / rms(&meas);
     let max_exp = meas.iter().map(|v| v.abs()).fold(0.0, f64::max);
     let max_sim = eta.iter().map(|v| v.abs()).fold(0.0, f64::max);
@@ -638,7 +630,7 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
             he.iter().cloned().fold(0.0, f64::max)
         );
         panels.push(Panel {
-            title: format!("{name}"),
+            title: name.to_string(),
             y_label: "water height (m)".into(),
             series: vec![
                 series("slosh (DFSPH, dp 40 mm)", &t, &hs, false),
