@@ -424,15 +424,10 @@ impl SimParams {
         Some((thickness, face))
     }
 
-    /// Floating bodies need wall particle layers (and with WCSPH its symplectic integrator), each checked
-    /// against the tank.
     /// The tank's inside in x, y, z (tank frame: origin at the centre of the bottom), lower and upper corner.
     fn tank_inside(&self) -> ([f64; 3], [f64; 3]) {
-        let t = &self.tank;
-        (
-            [-t.length / 2.0, -t.breadth / 2.0, 0.0],
-            [t.length / 2.0, t.breadth / 2.0, t.height],
-        )
+        let t = crate::tank::TankBox::<3>::new(self);
+        (t.lo, t.hi)
     }
 
     /// Obstacles lie within the tank, are at least a kernel support thick (the liquid must not see through
@@ -501,6 +496,8 @@ impl SimParams {
         Ok(())
     }
 
+    /// Floating bodies need wall particle layers (and with WCSPH its symplectic integrator), each checked
+    /// against the tank.
     fn validate_bodies(&self) -> Result<(), ParamError> {
         if let (Some(wm), Some((thickness, _))) = (&self.wave_maker, self.wave_maker_plate()) {
             wm.validate(self.tank.length, thickness, self.particle_spacing)?;
