@@ -778,6 +778,26 @@ impl SimParams {
                     ),
                 ));
             }
+            // On an obstacle's face (within half a spacing) it reads that face; deeper, it would be
+            // inside the solid.
+            let inside = |o: &crate::body::RegionSpec| {
+                let margin = -0.5 * self.particle_spacing;
+                if self.dimension == 2 {
+                    crate::tank::in_obstacle::<2>(o, [p.x, p.z], margin)
+                } else {
+                    crate::tank::in_obstacle::<3>(o, [p.x, p.y, p.z], margin)
+                }
+            };
+            if let Some(o) = self.obstacles.iter().find(|o| inside(o)) {
+                return Err(err(
+                    "pressure_sensors",
+                    format!(
+                        "sensor {i} ({}) at ({}, {}, {}) m is inside obstacle `{}`: put it on one of the \
+                         obstacle's faces (within half a particle spacing) or in the liquid",
+                        p.name, p.x, p.y, p.z, o.name
+                    ),
+                ));
+            }
         }
         Ok(())
     }

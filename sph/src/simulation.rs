@@ -91,6 +91,8 @@ pub struct Simulation<const D: usize, K: Kernel> {
     dom: Option<Domain>,
     /// Floating bodies (their particles are among `bound`).
     bodies: crate::body::Bodies,
+    /// Per pressure sensor, the wall face it reads, if it sits on one.
+    spots: Vec<Option<wall_pressure::FaceSpot<D>>>,
 }
 
 impl<const D: usize, K: Kernel> Simulation<D, K> {
@@ -149,10 +151,15 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             bodies.list.push(RigidBody::driven("wave_maker", wm, &pts));
             body_points.push(pts);
         }
-        // Fixed obstacles: the liquid starts where they and half a spacing around them hold none.
+        // Fixed obstacles, as their particles make them: the liquid starts where they and half a spacing
+        // around them hold none (one spacing from their outer particles, as at a wall).
+        let built: Vec<crate::body::RegionSpec> = params
+            .obstacles
+            .iter()
+            .map(|o| crate::tank::obstacle_as_built::<D>(&params, o))
+            .collect();
         points.retain(|x| {
-            !params
-                .obstacles
+            !built
                 .iter()
                 .any(|o| crate::tank::in_obstacle(o, *x, 0.499 * dp))
         });
@@ -215,8 +222,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 params.bodies.iter().any(|b| {
                     let p = std::array::from_fn(|k| x[k] - b.position[k]);
                     shell::covers(b, D, p, support)
-                }) || params
-                    .obstacles
+                }) || built
                     .iter()
                     .any(|o| crate::tank::in_obstacle::<3>(o, x, support))
                     || params.wave_maker_plate().is_some_and(|(_, face)| {
@@ -281,6 +287,16 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         } else {
             1e-4 * s.cfl * h / c0
         };
+        let spacing = crate::tank::wall_spacing::<D>(&params);
+        let spots = params
+            .pressure_sensors
+            .iter()
+            .map(|s| {
+                let at: [f64; D] = from3([s.x, s.y, s.z]);
+                let obstacles = (params.obstacles.as_slice(), built.as_slice());
+                wall_pressure::FaceSpot::locate(&tank, obstacles, at, 0.5 * dp, spacing, h)
+            })
+            .collect();
         let mut sim = Self {
             params,
             kernel,
@@ -309,6 +325,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             step_limit: f64::INFINITY,
             dom,
             bodies,
+            spots,
         };
         if !sim.bodies.is_empty() {
             sim.bodies.last_flooded = Some((0.0, sim.flooded_volumes()));
@@ -893,10 +910,11 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             .params
             .pressure_sensors
             .iter()
-            .map(|s| {
+            .zip(&self.spots)
+            .map(|(s, spot)| {
                 let at: [f64; D] = from3([s.x, s.y, s.z]);
-                match wall_pressure::face_of(&self.tank, at, 0.5 * dp) {
-                    Some(face) if dfsph => {
+                match spot {
+                    Some(spot) if dfsph => {
                         // A sum over the wall particles behind the sensor, which may reach further than a
                         // halo: across ranks, each adds its own walls' part.
                         let f = &self.fluid;
@@ -913,12 +931,16 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                                 self.coef.m_bound as f64,
                                 dfsph::MIRROR as f64,
                             ),
-                            at,
-                            face,
+                            spot,
+                            0.5 * dp,
                         )
                     }
                     _ if !mine(s.x) => 0.0,
-                    _ => pressure::pressure(k, &self.grid, &self.fluid, m, at),
+                    // On a face: at the face as built.
+                    _ => {
+                        let at = spot.as_ref().map_or(at, |s| s.at);
+                        pressure::pressure(k, &self.grid, &self.fluid, m, at)
+                    }
                 }
             })
             .collect();

@@ -144,6 +144,40 @@ pub fn obstacle_lattice<const D: usize>(p: &SimParams) -> Vec<[f64; D]> {
         .collect()
 }
 
+/// The spacing of the tank's wall lattice along each axis (the inside's extent over a whole number of
+/// spacings nearest `particle_spacing`).
+pub fn wall_spacing<const D: usize>(p: &SimParams) -> [f64; D] {
+    let tank = TankBox::<D>::new(p);
+    std::array::from_fn(|k| axis(tank.hi[k] - tank.lo[k], p.particle_spacing).1)
+}
+
+/// The obstacle as its particles make it: the box whose faces lie half a spacing beyond its outermost
+/// particles, i.e. each face of the given box moved to the nearest plane between two layers of the tank's wall
+/// lattice (at most half a spacing). The liquid starts off these faces and a pressure sensor on an obstacle
+/// reads them.
+pub fn obstacle_as_built<const D: usize>(
+    p: &SimParams,
+    o: &crate::body::RegionSpec,
+) -> crate::body::RegionSpec {
+    let tank = TankBox::<D>::new(p);
+    let mut out = o.clone();
+    for k in 0..D {
+        let a = if D == 2 { 2 * k } else { k };
+        let (n, s) = axis(tank.hi[k] - tank.lo[k], p.particle_spacing);
+        // The lattice coordinates inside the box, by the test `obstacle_lattice` makes.
+        let inside: Vec<f64> = (0..n)
+            .map(|i| tank.lo[k] + (i as f64 + 0.5) * s)
+            .filter(|x| (x - o.centre[a]).abs() < 0.5 * o.size[a])
+            .collect();
+        if let (Some(first), Some(last)) = (inside.first(), inside.last()) {
+            let (lo, hi) = (first - 0.5 * s, last + 0.5 * s);
+            out.centre[a] = 0.5 * (lo + hi);
+            out.size[a] = hi - lo;
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -196,5 +230,38 @@ mod tests {
         assert_eq!(w.len(), 46 * 36 - 40 * 30);
         let b = TankBox::<2>::new(&p);
         assert!(w.iter().all(|x| !b.contains(*x)));
+    }
+
+    #[test]
+    fn an_obstacle_is_built_from_the_wall_lattice_points_inside_it() {
+        let mut p = params(3);
+        let o = crate::body::RegionSpec {
+            name: "block".into(),
+            centre: [0.0215, 0.0, 0.0415],
+            size: [0.103, 0.1, 0.083],
+        };
+        p.obstacles = vec![o.clone()];
+        let b = obstacle_as_built::<3>(&p, &o);
+        // x: the tank's 40 spacings of 0.02 m, points at ±0.01, ±0.03, ... inside (−0.03, 0.073): faces at −0.02,
+        // 0.08; y: 13 spacings of 0.25 / 13 m, five points inside (−0.05, 0.05); z: 0.01 ... 0.07.
+        let sy = 0.25 / 13.0;
+        let lo: [f64; 3] = std::array::from_fn(|k| b.centre[k] - 0.5 * b.size[k]);
+        let hi: [f64; 3] = std::array::from_fn(|k| b.centre[k] + 0.5 * b.size[k]);
+        for (got, want) in
+            lo.iter()
+                .zip([-0.02, -2.5 * sy, 0.0])
+                .chain(hi.iter().zip([0.08, 2.5 * sy, 0.08]))
+        {
+            assert!((got - want).abs() < 1e-12, "{lo:?} {hi:?}");
+        }
+        // Every particle of the obstacle lies inside the box as built, half a spacing or more off its faces.
+        let pts = obstacle_lattice::<3>(&p);
+        assert_eq!(pts.len(), 5 * 5 * 4);
+        for x in &pts {
+            assert!(
+                (0..3).all(|k| x[k] > lo[k] + 0.45 * sy && x[k] < hi[k] - 0.45 * sy),
+                "{x:?}"
+            );
+        }
     }
 }

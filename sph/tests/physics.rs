@@ -859,16 +859,19 @@ fn steps_land_on_the_requested_times_without_slivers() {
 }
 
 /// A block fixed to the floor in the middle of a 2D tank at rest (`obstacles`), with each scheme: the liquid
-/// starts outside it and stays out, its surface is level at the fill height on either side and above it
-/// (the block displaces exactly the liquid left out), and the tank, block included, carries the liquid's
-/// weight straight down.
+/// starts outside it and stays out, its surface is level on either side and above it at the height its mass
+/// stands at (the block displaces exactly the liquid left out), and the tank, block included, carries the liquid's
+/// weight straight down; sensors on the block's sides and top read the hydrostatic pressure there. The
+/// block's size is no multiple of the spacing: its particles are the tank's wall lattice points inside it, its
+/// faces as built half a spacing beyond them (0.0515 → 0.05, 0.083 → 0.08), which the liquid and the sensors
+/// given on the faces as asked go by.
 #[test]
 fn an_obstacle_on_the_floor_holds_the_liquid_at_rest_and_carries_its_weight() {
     let (dp, fill) = (0.01, 0.15);
     let block = sph::body::RegionSpec {
         name: "block".into(),
-        centre: [0.0, 0.0, 0.04],
-        size: [0.1, 0.25, 0.08],
+        centre: [0.0, 0.0, 0.0415],
+        size: [0.103, 0.25, 0.083],
     };
     for scheme in [Scheme::Wcsph, Scheme::Dfsph] {
         let mut p = tank2d(0.4, 0.3, fill, dp);
@@ -880,18 +883,41 @@ fn an_obstacle_on_the_floor_holds_the_liquid_at_rest_and_carries_its_weight() {
             probe("over", 0.0),
             probe("right", 0.15),
         ];
+        // Pressure sensors on the block's faces (its two sides and its top) and on the tank wall beside it.
+        let sensor = |name: &str, x: f64, z: f64| SensorSpec {
+            name: name.into(),
+            x,
+            y: 0.0,
+            z,
+        };
+        p.pressure_sensors = vec![
+            sensor("block_left", -0.0515, 0.03),
+            sensor("block_right", 0.0515, 0.05),
+            sensor("block_top", 0.02, 0.083),
+            sensor("wall", -0.2, 0.04),
+        ];
         let mut sim = sph::build(p.clone()).unwrap();
-        // Liquid mass: the fill block less the block's section, over the tank's breadth.
-        let want = 1000.0 * (0.4 * fill - 0.1 * 0.08) * p.tank.breadth;
+        let built = sph::tank::obstacle_as_built::<2>(&p, &block);
+        assert!(
+            (built.size[0] - 0.1).abs() < 1e-9 && (built.size[2] - 0.08).abs() < 1e-9,
+            "the block as built: {built:?}"
+        );
+        // Liquid mass: the fill block less the block's section as built, over the tank's breadth (here the
+        // liquid's lattice is the tank's: exactly, to the particle mass's f32 rounding).
+        let (w, hb) = (built.size[0], built.size[2]);
+        let want = 1000.0 * (0.4 * fill - w * hb) * p.tank.breadth;
+        let slack = 1e-6 * want;
         let mass = sim.liquid_mass();
         assert!(
-            (mass - want).abs() < 0.01 * want,
-            "{scheme:?}: liquid mass {mass} kg, fill less the block {want}"
+            (mass - want).abs() <= slack,
+            "{scheme:?}: liquid mass {mass} kg, fill less the block {want} (within {slack})"
         );
+        // The level that mass stands at once the liquid has closed up to the block.
+        let level = (mass / (1000.0 * p.tank.breadth) + w * hb) / 0.4;
         let inside = |sim: &dyn Solver| {
             sim.fluid_positions()
                 .iter()
-                .filter(|x| x[0].abs() < 0.05 - 0.5 * dp && x[2] < 0.08 - 0.5 * dp)
+                .filter(|x| x[0].abs() < 0.5 * w - 0.5 * dp && x[2] < hb - 0.5 * dp)
                 .count()
         };
         assert_eq!(
@@ -901,8 +927,9 @@ fn an_obstacle_on_the_floor_holds_the_liquid_at_rest_and_carries_its_weight() {
         );
         let o = run_and_average(sim.as_mut(), &AtRest, 0.6, 1.0, 0.02);
         eprintln!(
-            "obstacle at rest ({scheme:?}): probes {:?} m (fill {fill}), force {:?} N, weight {} N",
+            "obstacle at rest ({scheme:?}): probes {:?} m (level {level}), sensors {:?} Pa, force {:?} N, weight {} N",
             o.probes,
+            o.pressures,
             o.wrench.force,
             mass * G
         );
@@ -913,8 +940,25 @@ fn an_obstacle_on_the_floor_holds_the_liquid_at_rest_and_carries_its_weight() {
         );
         for (v, s) in o.probes.iter().zip(&p.probes) {
             assert!(
-                (v - fill).abs() < 0.5 * dp,
-                "{scheme:?}: probe {} reads {v}, fill {fill}",
+                (v - level).abs() < 0.5 * dp,
+                "{scheme:?}: probe {} reads {v}, level {level}",
+                s.name
+            );
+        }
+        for (v, s) in o.pressures.iter().zip(&p.pressure_sensors) {
+            // The top's sensor reads the top as built. WCSPH's Shepard mean on a face reads the pressure
+            // ~0.65 h into the liquid: on the top, ρ g 0.65 h (9 %) low; on the sides the depth is the same.
+            let top = s.name == "block_top";
+            let z = if top { hb } else { s.z };
+            let expect = 1000.0 * G * (level - z);
+            let tol = if top && scheme == Scheme::Wcsph {
+                0.12
+            } else {
+                0.05
+            };
+            assert!(
+                (v - expect).abs() < tol * expect,
+                "{scheme:?}: sensor {} reads {v} Pa, hydrostatic {expect} Pa",
                 s.name
             );
         }
@@ -934,7 +978,7 @@ fn an_obstacle_on_the_floor_holds_the_liquid_at_rest_and_carries_its_weight() {
 }
 
 /// Obstacles that would not work are refused by name: thinner than the kernel support, reaching outside the
-/// tank, or with mirror walls (they are made of wall particles).
+/// tank, or with mirror walls (they are made of wall particles); so is a pressure sensor buried in one.
 #[test]
 fn obstacles_that_would_not_work_are_refused_by_name() {
     let base = sph::body::RegionSpec {
@@ -962,6 +1006,26 @@ fn obstacles_that_would_not_work_are_refused_by_name() {
         e.contains("obstacles.block.centre") && e.contains("outside the tank"),
         "{e}"
     );
+    // A pressure sensor inside the block (deeper than half a spacing from its faces).
+    let mut p = tank2d(0.4, 0.3, 0.15, 0.01);
+    p.solver.boundary.method = BoundaryMethod::Dynamic;
+    p.obstacles = vec![base.clone()];
+    p.pressure_sensors = vec![SensorSpec {
+        name: "buried".into(),
+        x: -0.04,
+        y: 0.0,
+        z: 0.03,
+    }];
+    let e = sph::build(p.clone()).err().expect("refused").to_string();
+    assert!(
+        e.contains("pressure_sensors")
+            && e.contains("buried")
+            && e.contains("inside obstacle `block`"),
+        "{e}"
+    );
+    // On its face (within half a spacing) it is taken.
+    p.pressure_sensors[0].x = -0.046;
+    sph::build(p).expect("a sensor on the block's face");
     let e = refused(base, BoundaryMethod::Mirror);
     assert!(
         e.contains("obstacles.block") && e.contains("method: dynamic"),

@@ -585,7 +585,9 @@ fn bouscasse_2013(overrides: &[&str], name: &str, label: &str) {
 /// SPHERIC Test 2 (Kleefsman et al. 2005): the 3D dam break onto a box fixed to the floor (`obstacles`), with
 /// the case's incompressible scheme at 40 mm, 0-6 s: the water heights H1-H4 against the record, each in
 /// shape (correlation > 0.85) and size (rms within 25 %), and the front's arrival at H1, H2 (0.5 and 1.0 m
-/// from the column) within 0.05 s and at H3 (1.5 m, beyond the box) within 0.15 s of the measured one.
+/// from the column) within 0.05 s and at H3 (1.5 m, beyond the box) within 0.15 s of the measured one; the
+/// pressure on the box (P1-P4 on its face towards the column, P5-P8 on its top) in shape (correlation > 0.8)
+/// and mean after the impact (1-6 s, within 20 %), and the impact on P1-P4 within 0.03 s.
 #[test]
 fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
     let rows = table(&read("kleefsman_spheric2/test_case_2_exp_data.dat"));
@@ -653,5 +655,62 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
             late.abs() < tol,
             "{name}: front {late} s after the measured one (within {tol})"
         );
+    }
+    // The box's pressure sensors: P1-P4 on its face towards the column, P5-P8 on its top.
+    let mut panels = vec![];
+    let mut checks = vec![];
+    for k in 0..8 {
+        let name = format!("P{}", k + 1);
+        let pe: Vec<f64> = exp.iter().map(|r| r[1 + k]).collect();
+        let ps: Vec<f64> = obs.iter().map(|o| o.pressures[k]).collect();
+        let at: Vec<f64> = te.iter().map(|&x| interp(&t, &ps, x)).collect();
+        let corr = correlation(&at, &pe);
+        let mean_after = |v: &[f64]| {
+            let w: Vec<f64> = te
+                .iter()
+                .zip(v)
+                .filter(|(t, _)| **t > 1.0)
+                .map(|(_, p)| *p)
+                .collect();
+            w.iter().sum::<f64>() / w.len() as f64
+        };
+        let (ms, me) = (mean_after(&at), mean_after(&pe));
+        // The impact: the first time the pressure passes 500 Pa.
+        let wet = |v: &[f64]| te[v.iter().position(|&p| p > 500.0).unwrap_or(v.len() - 1)];
+        let (ws, we) = (wet(&at), wet(&pe));
+        eprintln!(
+            "Kleefsman 2005 (DFSPH, dp 40 mm) {name}: correlation {corr:.3}, mean after 1 s {ms:.0} Pa against {me:.0} Pa, peak {:.0} Pa against {:.0} Pa, above 500 Pa from {ws:.3} s against {we:.3} s",
+            at.iter().cloned().fold(0.0, f64::max),
+            pe.iter().cloned().fold(0.0, f64::max)
+        );
+        panels.push(Panel {
+            title: name.clone(),
+            y_label: "pressure (Pa)".into(),
+            series: vec![
+                series("slosh (DFSPH, dp 40 mm)", &t, &ps, false),
+                series("measured (MARIN, SPHERIC Test 2)", &te, &pe, true),
+            ],
+            level: None,
+        });
+        checks.push((name, corr, ms / me, ws - we));
+    }
+    figure_panels(
+        "kleefsman2005_dambreak_dfsph_pressure",
+        "SPHERIC Test 2 (Kleefsman et al. 2005): pressure on the box, P1-P4 front, P5-P8 top",
+        panels,
+    );
+    for (k, (name, corr, mean, late)) in checks.into_iter().enumerate() {
+        assert!(corr > 0.8, "{name}: correlation {corr}");
+        assert!(
+            (mean - 1.0).abs() < 0.2,
+            "{name}: mean after 1 s {mean} of the record's"
+        );
+        // The front's impact on the face (P1-P4); the top gets wet in splashes first.
+        if k < 4 {
+            assert!(
+                late.abs() < 0.03,
+                "{name}: impact {late} s after the measured one"
+            );
+        }
     }
 }
