@@ -7,7 +7,7 @@ use crate::body::RegionSpec;
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, NO_RANGES};
 use crate::particles::{Boundary, Fluid};
-use crate::tank::TankBox;
+use crate::tank::{from3, TankBox};
 
 /// The wall face a pressure sensor sits on.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -38,11 +38,6 @@ pub fn face_of<const D: usize>(tank: &TankBox<D>, p: [f64; D], tol: f64) -> Opti
     })
 }
 
-/// The axes of a box's (x, y, z) a D-dimensional point's coordinates stand for (2D: x and z).
-fn axes3<const D: usize>() -> [usize; D] {
-    std::array::from_fn(|d| if D == 2 { 2 * d } else { d })
-}
-
 /// The face of an obstacle box (tank frame) the point `p` lies on within `tol`, with its distance from it;
 /// the nearest where `p` is within `tol` of two (by an edge).
 pub fn obstacle_face_of<const D: usize>(
@@ -50,9 +45,9 @@ pub fn obstacle_face_of<const D: usize>(
     p: [f64; D],
     tol: f64,
 ) -> Option<(usize, f64, f64)> {
-    let ax = axes3::<D>();
-    let half = |d: usize| 0.5 * o.size[ax[d]];
-    let off = |d: usize| p[d] - o.centre[ax[d]];
+    let (centre, size): ([f64; D], [f64; D]) = (from3(o.centre), from3(o.size));
+    let half = |d: usize| 0.5 * size[d];
+    let off = |d: usize| p[d] - centre[d];
     if (0..D).any(|d| off(d).abs() > half(d) + tol) {
         return None;
     }
@@ -152,11 +147,11 @@ impl<const D: usize> FaceSpot<D> {
         let (lo, hi) = match face.obstacle {
             None => (tank.lo, tank.hi),
             Some(k) => {
-                let o = &built[k];
-                let ax = axes3::<D>();
+                let (centre, size): ([f64; D], [f64; D]) =
+                    (from3(built[k].centre), from3(built[k].size));
                 (
-                    std::array::from_fn(|d| o.centre[ax[d]] - 0.5 * o.size[ax[d]]),
-                    std::array::from_fn(|d| o.centre[ax[d]] + 0.5 * o.size[ax[d]]),
+                    std::array::from_fn(|d| centre[d] - 0.5 * size[d]),
+                    std::array::from_fn(|d| centre[d] + 0.5 * size[d]),
                 )
             }
         };
