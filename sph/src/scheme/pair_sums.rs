@@ -104,17 +104,44 @@ impl<const D: usize, const W: usize> Grad<D, W> for [f32; W] {
         g: &[Self],
         vel: &[[f32; W]],
         va: [f32; W],
-        _wide: bool,
+        wide: bool,
     ) -> [f32; W] {
+        #[cfg(target_arch = "x86_64")]
+        if wide && W == 2 {
+            // SAFETY: W == 2, so `[f32; W]` is `[f32; 2]` (same size and alignment); the caller guarantees
+            // j < vel.len() and AVX2 (so AVX) where `wide`.
+            let r = unsafe { avx::divergence2(j, as_pairs(g), as_pairs(vel), [va[0], va[1]]) };
+            return std::array::from_fn(|d| r[d]);
+        }
+        let _ = wide;
         // SAFETY: as the caller guarantees.
         unsafe { plain_divergence::<D, W, Self>(j, g, vel, va) }
     }
 
     #[inline(always)]
-    unsafe fn push(j: &[u32], g: &[Self], k: &[f32], ka: f32, _wide: bool) -> [f32; W] {
+    unsafe fn push(j: &[u32], g: &[Self], k: &[f32], ka: f32, wide: bool) -> [f32; W] {
+        #[cfg(target_arch = "x86_64")]
+        if wide && W == 2 {
+            // SAFETY: as in `divergence`; the caller guarantees j < k.len().
+            let r = unsafe { avx::push2(j, as_pairs(g), k, ka) };
+            return std::array::from_fn(|d| r[d]);
+        }
+        let _ = wide;
         // SAFETY: as the caller guarantees.
         unsafe { plain_push::<D, W, Self>(j, g, k, ka) }
     }
+}
+
+/// `[f32; W]` records seen as `[f32; 2]` (the 2D lists').
+///
+/// # Safety
+/// W == 2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn as_pairs<const W: usize>(v: &[[f32; W]]) -> &[[f32; 2]] {
+    debug_assert_eq!(W, 2);
+    // SAFETY: with W == 2 the element types are the same.
+    unsafe { std::slice::from_raw_parts(v.as_ptr().cast(), v.len()) }
 }
 
 /// [`Grad::divergence`] by the generic loop over the records' f32 lanes (what every path must equal).
@@ -205,7 +232,7 @@ impl<const D: usize> Grad<D, 4> for Half4 {
     }
 }
 
-/// The half-precision sums two pairs at a time: pairs 4n and 4n + 1 share one 256-bit register (the chains
+/// The half-precision sums two pairs at a time (and the 2D f32 sums four at a time): pairs 4n and 4n + 1 share one 256-bit register (the chains
 /// 0 and 1 of [`pair_sum`] in its halves), pairs 4n + 2 and 4n + 3 another, so each lane sees the same
 /// additions in the same order as the generic loop and the results are the same to the bit (tested); two
 /// records are one 16-byte load and one conversion to f32.
@@ -331,6 +358,105 @@ mod avx {
             |j, g| unsafe { _mm_mul_ps(_mm_set1_ps(ka + k.get_unchecked(j as usize)), g) }
         )
     }
+
+    /// The chains of [`super::pair_sum`] over 2D f32 records, all four in one 256-bit register (chain l in
+    /// lanes 2l and 2l + 1): `$four(js, g)` gives the terms of four pairs (`js` their indices, `g` their four
+    /// records, one 32-byte load), the remainder goes pair by pair into chains 0, 1, 2, so every lane sees
+    /// the generic loop's additions in its order.
+    macro_rules! chains2 {
+        ($j:expr, $g:expr, |$js:ident, $g4:ident| $four:expr, |$j1:ident, $gr:ident| $one:expr) => {{
+            let (j, g): (&[u32], &[[f32; 2]]) = ($j, $g);
+            let mut acc = _mm256_setzero_ps();
+            let (jc, jr) = j.split_at(j.len() - j.len() % CHAINS);
+            let (gc, gr) = g.split_at(jc.len());
+            for ($js, gs) in jc.chunks_exact(CHAINS).zip(gc.chunks_exact(CHAINS)) {
+                // SAFETY: 32 readable bytes: four consecutive records.
+                let $g4 = unsafe { _mm256_loadu_ps(gs.as_ptr().cast()) };
+                acc = _mm256_add_ps(acc, $four);
+            }
+            let mut c = [0.0f32; 8];
+            // SAFETY: 32 writable bytes.
+            unsafe { _mm256_storeu_ps(c.as_mut_ptr(), acc) };
+            for (l, ($j1, $gr)) in jr.iter().zip(gr).enumerate() {
+                let t: [f32; 2] = $one;
+                c[2 * l] += t[0];
+                c[2 * l + 1] += t[1];
+            }
+            [(c[0] + c[2]) + (c[4] + c[6]), (c[1] + c[3]) + (c[5] + c[7])]
+        }};
+    }
+
+    /// Four 2D records (8 bytes each) at `p[j0..4]` in one register.
+    ///
+    /// # Safety
+    /// The CPU has AVX; every index in `js` is below `p.len()`.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    unsafe fn four(p: &[[f32; 2]], js: &[u32]) -> __m256 {
+        // SAFETY: the caller guarantees the indices; 8 readable bytes each.
+        unsafe {
+            let at =
+                |l: usize| p.get_unchecked(*js.get_unchecked(l) as usize).as_ptr() as *const f64;
+            let lo = _mm_loadh_pd(_mm_load_sd(at(0)), at(1));
+            let hi = _mm_loadh_pd(_mm_load_sd(at(2)), at(3));
+            _mm256_castpd_ps(_mm256_set_m128d(hi, lo))
+        }
+    }
+
+    /// [`super::Grad::divergence`] of 2D f32 records, four pairs at a time.
+    ///
+    /// # Safety
+    /// The CPU has AVX; every index in `j` is below `vel.len()`.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    pub(super) unsafe fn divergence2(
+        j: &[u32],
+        g: &[[f32; 2]],
+        vel: &[[f32; 2]],
+        va: [f32; 2],
+    ) -> [f32; 2] {
+        let va4 = _mm256_castpd_ps(_mm256_set1_pd(f64::from_bits(
+            (va[0].to_bits() as u64) | (va[1].to_bits() as u64) << 32,
+        )));
+        // SAFETY (the neighbours' velocities): the caller guarantees j < vel.len().
+        chains2!(
+            j,
+            g,
+            |js, g| unsafe { _mm256_mul_ps(_mm256_sub_ps(va4, four(vel, js)), g) },
+            |jj, gg| {
+                // SAFETY: as above.
+                let vb = unsafe { vel.get_unchecked(*jj as usize) };
+                [(va[0] - vb[0]) * gg[0], (va[1] - vb[1]) * gg[1]]
+            }
+        )
+    }
+
+    /// [`super::Grad::push`] of 2D f32 records, four pairs at a time.
+    ///
+    /// # Safety
+    /// The CPU has AVX; every index in `j` is below `k.len()`.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    pub(super) unsafe fn push2(j: &[u32], g: &[[f32; 2]], k: &[f32], ka: f32) -> [f32; 2] {
+        let ka4 = _mm_set1_ps(ka);
+        // SAFETY (the neighbours' k): the caller guarantees j < k.len().
+        chains2!(
+            j,
+            g,
+            |js, g| unsafe {
+                let kk = |l: usize| *k.get_unchecked(*js.get_unchecked(l) as usize);
+                // ka + k_j for the four pairs, each twice (x and y lanes).
+                let s = _mm_add_ps(ka4, _mm_set_ps(kk(3), kk(2), kk(1), kk(0)));
+                let s2 = _mm256_set_m128(_mm_unpackhi_ps(s, s), _mm_unpacklo_ps(s, s));
+                _mm256_mul_ps(s2, g)
+            },
+            |jj, gg| {
+                // SAFETY: as above.
+                let s = ka + unsafe { k.get_unchecked(*jj as usize) };
+                [s * gg[0], s * gg[1]]
+            }
+        )
+    }
 }
 
 #[cfg(test)]
@@ -398,6 +524,44 @@ mod tests {
             }
             assert!(len == 0 || plain.iter().any(|x| *x != 0.0));
             assert_eq!(plain[3], 0.0, "the padding lane");
+        }
+    }
+
+    #[test]
+    fn two_dimensional_sums_four_pairs_at_a_time_equal_the_generic_loop_to_the_bit() {
+        for len in [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 19, 22] {
+            let (j, g, vel, k) = data(len);
+            let two = |v: &[f32; 4]| [v[0], v[1]];
+            let g2: Vec<[f32; 2]> = g.iter().map(|h| two(&h.unpack())).collect();
+            let vel2: Vec<[f32; 2]> = vel.iter().map(two).collect();
+            let va = vel2[3];
+            // SAFETY: every j < 50, the particles' count; `wide` only where `wide_lanes()` holds.
+            let (d, p) = unsafe {
+                (
+                    plain_divergence::<2, 2, [f32; 2]>(&j, &g2, &vel2, va),
+                    plain_push::<2, 2, [f32; 2]>(&j, &g2, &k, k[7]),
+                )
+            };
+            for wide in ways() {
+                // SAFETY: as above.
+                let (fd, fp) = unsafe {
+                    (
+                        <[f32; 2] as Grad<2, 2>>::divergence(&j, &g2, &vel2, va, wide),
+                        <[f32; 2] as Grad<2, 2>>::push(&j, &g2, &k, k[7], wide),
+                    )
+                };
+                assert_eq!(
+                    d.map(f32::to_bits),
+                    fd.map(f32::to_bits),
+                    "divergence, {len} pairs, wide {wide}"
+                );
+                assert_eq!(
+                    p.map(f32::to_bits),
+                    fp.map(f32::to_bits),
+                    "push, {len} pairs, wide {wide}"
+                );
+            }
+            assert!(len == 0 || (d.iter().any(|x| *x != 0.0) && p.iter().any(|x| *x != 0.0)));
         }
     }
 
