@@ -995,7 +995,26 @@ pub fn step<'r, const D: usize, K: Kernel>(
         bound,
         wide: wide_lanes(),
     };
-    let built = work.build(&p);
+    // Where the constant-density solve starts (the same for every try of the step): the warm start's
+    // columns are a serial pass over the liquid, which runs beside the parallel neighbourhood pass (both only
+    // read the particles) instead of leaving the other threads idle after it.
+    let mut start = std::mem::take(&mut work.start);
+    let mut columns = std::mem::take(&mut work.columns);
+    let setting = Setting {
+        dp,
+        rho_rest: c.rho_rest,
+        gz: -frame.g[2],
+        beta: if work.plain_warm_start || !Setting::applies(grid.cell_size(), dp) {
+            0.0
+        } else {
+            spec.hydrostatic_warm_start
+        },
+    };
+    let (built, ()) = rayon::join(
+        || work.build(&p),
+        || columns.warm_start(grid, p.fluid, setting, &mut start),
+    );
+    work.columns = columns;
     let mut report = StepReport {
         totals: built.totals,
         ..Default::default()
@@ -1031,23 +1050,6 @@ pub fn step<'r, const D: usize, K: Kernel>(
     }
     // Shortest step a solve that does not converge is retried at.
     let dt_floor = dt / 16.0;
-    // Where the constant-density solve starts (the same for every try of the step).
-    let mut start = std::mem::take(&mut work.start);
-    work.columns.warm_start(
-        grid,
-        fluid,
-        Setting {
-            dp,
-            rho_rest: c.rho_rest,
-            gz: -frame.g[2],
-            beta: if work.plain_warm_start || !Setting::applies(grid.cell_size(), dp) {
-                0.0
-            } else {
-                spec.hydrostatic_warm_start
-            },
-        },
-        &mut start,
-    );
     loop {
         report.totals = built.totals;
         let dtf = dt as f32;
