@@ -78,6 +78,11 @@ pub struct BenchResult {
     /// (communication and waiting for the other ranks).
     pub particle_steps_per_s_per_rank: f64,
     pub comm_share: f64,
+    /// Runs of the case (`--repeat`): the figures above are the run of median wall time's, and these the
+    /// fastest and the slowest run's wall times (equal to `wall_time_s` for one run).
+    pub repeats: u32,
+    pub wall_time_s_min: f64,
+    pub wall_time_s_max: f64,
 }
 
 /// A case with the overrides `set` applied after its own: its solver parameters and motion, checked.
@@ -133,5 +138,38 @@ pub fn run_case(case: &Case, duration: Option<f64>, set: &[String]) -> anyhow::R
         retried_steps: stats.retried_steps,
         particle_steps_per_s_per_rank: pst / sim.ranks() as f64,
         comm_share: comm / wall,
+        repeats: 1,
+        wall_time_s_min: wall,
+        wall_time_s_max: wall,
     })
+}
+
+/// Runs one case `repeats` times (a fresh simulation each time, the same work: the runs take the same steps)
+/// and returns the run of median wall time (the slower of the two middle ones for an even count), with the
+/// fastest and slowest runs' wall times: on a shared machine one run's speed can be tens of percent off.
+pub fn run_repeated(
+    case: &Case,
+    duration: Option<f64>,
+    set: &[String],
+    repeats: u32,
+) -> anyhow::Result<BenchResult> {
+    let mut runs = (0..repeats.max(1))
+        .map(|_| run_case(case, duration, set))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    if let Some(r) = runs.iter().find(|r| r.steps != runs[0].steps) {
+        anyhow::bail!(
+            "case {}: runs of the same case took {} and {} steps (they must do the same work)",
+            case.name,
+            runs[0].steps,
+            r.steps
+        );
+    }
+    runs.sort_by(|a, b| a.wall_time_s.total_cmp(&b.wall_time_s));
+    let (min, max) = (runs[0].wall_time_s, runs[runs.len() - 1].wall_time_s);
+    let n = runs.len();
+    let mut median = runs.swap_remove(n / 2);
+    median.repeats = n as u32;
+    median.wall_time_s_min = min;
+    median.wall_time_s_max = max;
+    Ok(median)
 }

@@ -137,6 +137,10 @@ enum Command {
         /// Print one JSON object per case instead of a table.
         #[arg(long)]
         json: bool,
+        /// Run each case this many times and report the run of median wall time, with the fastest and
+        /// slowest (a shared machine's speed can wander by tens of percent between runs).
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+        repeat: u32,
     },
     /// Time the transports without the physics: coupling round trips and particle frames over iceoryx2 and
     /// over DDS on loopback (run DDS inside `unshare -rn` to keep its discovery traffic on this machine).
@@ -605,6 +609,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             duration,
             set,
             json,
+            repeat,
         } => {
             let cases: Vec<&bench::Case> = if case.is_empty() {
                 bench::CASES.iter().collect()
@@ -645,12 +650,23 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 );
             }
             for c in cases {
-                let r = bench::run_case(c, duration, &set)?;
+                let r = bench::run_repeated(c, duration, &set, repeat)?;
                 if json {
                     println!("{}", serde_json::to_string(&r)?);
                 } else {
+                    // With --repeat: the median run, and the real-time factors of the slowest and fastest.
+                    let range = if r.repeats > 1 {
+                        format!(
+                            "  ({} runs: RT factor {:.4}–{:.4})",
+                            r.repeats,
+                            r.sim_time_s / r.wall_time_s_max,
+                            r.sim_time_s / r.wall_time_s_min
+                        )
+                    } else {
+                        String::new()
+                    };
                     println!(
-                        "{:<22} {:>5} {:>7} {:>9} {:>8} {:>8.3} {:>10.2} {:>14.3e} {:>10.4} {:>12.1} {:>7.1}",
+                        "{:<22} {:>5} {:>7} {:>9} {:>8} {:>8.3} {:>10.2} {:>14.3e} {:>10.4} {:>12.1} {:>7.1}{range}",
                         r.case,
                         r.ranks,
                         r.threads,

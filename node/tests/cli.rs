@@ -326,6 +326,56 @@ fn the_incompressible_scheme_runs_and_reports_its_pressure_solver() {
 }
 
 #[test]
+fn bench_repeats_a_case_and_reports_the_median_run_with_the_fastest_and_slowest() {
+    let args = |repeat: &str| {
+        slosh()
+            .args([
+                "bench",
+                "--case",
+                "seed_2d_dp8mm_dfsph",
+                "--duration",
+                "0.05",
+                "--set",
+                "particle_spacing=0.02",
+                "--json",
+                "--repeat",
+                repeat,
+            ])
+            .output()
+            .unwrap()
+    };
+    let st = args("3");
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let r: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
+    assert_eq!(r["repeats"], 3, "{r}");
+    let w = |k: &str| r[k].as_f64().unwrap();
+    assert!(
+        w("wall_time_s_min") <= w("wall_time_s") && w("wall_time_s") <= w("wall_time_s_max"),
+        "{r}"
+    );
+    assert!(w("wall_time_s_min") > 0.0);
+    // The figures are the median run's own: its real-time factor goes with its wall time.
+    assert!(
+        (w("realtime_factor") * w("wall_time_s") - w("sim_time_s")).abs() < 1e-9 * w("sim_time_s")
+    );
+    // One run: the range is that run.
+    let one: serde_json::Value = serde_json::from_slice(&args("1").stdout).unwrap();
+    assert_eq!(one["repeats"], 1);
+    assert_eq!(one["wall_time_s_min"], one["wall_time_s"]);
+    assert_eq!(one["wall_time_s_max"], one["wall_time_s"]);
+    assert_eq!(one["steps"], r["steps"], "the same work every run");
+    // No runs at all is refused by name.
+    let st = args("0");
+    assert!(!st.status.success());
+    let e = String::from_utf8_lossy(&st.stderr);
+    assert!(e.contains("--repeat"), "{e}");
+}
+
+#[test]
 fn bench_reports_json_and_applies_overrides() {
     let st = slosh()
         .args([
