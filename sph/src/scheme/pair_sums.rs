@@ -7,7 +7,8 @@
 //! memory) and the solver each velocity in four lanes; on x86_64 with AVX2 and F16C the sums convert
 //! two pairs' gradients with one instruction and run two pairs per 256-bit register, one load per
 //! neighbour's velocity; the results are the same to the bit as [`pair_sum`]'s over the converted
-//! gradients (tested).
+//! gradients (tested). The 2D lists keep f32 records, summed four pairs per 256-bit register with AVX2 (the
+//! same bits as [`pair_sum`]).
 
 use super::half::Half4;
 
@@ -232,10 +233,11 @@ impl<const D: usize> Grad<D, 4> for Half4 {
     }
 }
 
-/// The half-precision sums two pairs at a time (and the 2D f32 sums four at a time): pairs 4n and 4n + 1 share one 256-bit register (the chains
+/// The half-precision sums two pairs at a time: pairs 4n and 4n + 1 share one 256-bit register (the chains
 /// 0 and 1 of [`pair_sum`] in its halves), pairs 4n + 2 and 4n + 3 another, so each lane sees the same
 /// additions in the same order as the generic loop and the results are the same to the bit (tested); two
-/// records are one 16-byte load and one conversion to f32.
+/// records are one 16-byte load and one conversion to f32. The 2D f32 sums take four pairs at a time, the
+/// four chains side by side in one register (`divergence2`, `push2`; the same bits too).
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use super::{Half4, CHAINS};
@@ -386,10 +388,10 @@ mod avx {
         }};
     }
 
-    /// Four 2D records (8 bytes each) at `p[j0..4]` in one register.
+    /// The four 2D records (8 bytes each) `p[js[0]]` … `p[js[3]]` in one register, in that order.
     ///
     /// # Safety
-    /// The CPU has AVX; every index in `js` is below `p.len()`.
+    /// The CPU has AVX; `js` holds at least four indices, each below `p.len()`.
     #[inline]
     #[target_feature(enable = "avx")]
     unsafe fn four(p: &[[f32; 2]], js: &[u32]) -> __m256 {
