@@ -325,26 +325,27 @@ fn the_incompressible_scheme_runs_and_reports_its_pressure_solver() {
     );
 }
 
+/// `slosh bench --json` on the 2D incompressible case, 0.05 s at 20 mm, with `extra` arguments.
+fn small_bench(extra: &[&str]) -> std::process::Output {
+    slosh()
+        .args([
+            "bench",
+            "--case",
+            "seed_2d_dp8mm_dfsph",
+            "--duration",
+            "0.05",
+            "--set",
+            "particle_spacing=0.02",
+            "--json",
+        ])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn bench_repeats_a_case_and_reports_the_median_run_with_the_fastest_and_slowest() {
-    let args = |repeat: &str| {
-        slosh()
-            .args([
-                "bench",
-                "--case",
-                "seed_2d_dp8mm_dfsph",
-                "--duration",
-                "0.05",
-                "--set",
-                "particle_spacing=0.02",
-                "--json",
-                "--repeat",
-                repeat,
-            ])
-            .output()
-            .unwrap()
-    };
-    let st = args("3");
+    let st = small_bench(&["--repeat", "3"]);
     assert!(
         st.status.success(),
         "{}",
@@ -362,14 +363,11 @@ fn bench_repeats_a_case_and_reports_the_median_run_with_the_fastest_and_slowest(
     assert!(
         (w("realtime_factor") * w("wall_time_s") - w("sim_time_s")).abs() < 1e-9 * w("sim_time_s")
     );
-    // One run: the range is that run.
-    let one: serde_json::Value = serde_json::from_slice(&args("1").stdout).unwrap();
-    assert_eq!(one["repeats"], 1);
-    assert_eq!(one["wall_time_s_min"], one["wall_time_s"]);
-    assert_eq!(one["wall_time_s_max"], one["wall_time_s"]);
+    // The same work as one run.
+    let one: serde_json::Value = serde_json::from_slice(&small_bench(&[]).stdout).unwrap();
     assert_eq!(one["steps"], r["steps"], "the same work every run");
     // No runs at all is refused by name.
-    let st = args("0");
+    let st = small_bench(&["--repeat", "0"]);
     assert!(!st.status.success());
     let e = String::from_utf8_lossy(&st.stderr);
     assert!(e.contains("--repeat"), "{e}");
@@ -377,19 +375,7 @@ fn bench_repeats_a_case_and_reports_the_median_run_with_the_fastest_and_slowest(
 
 #[test]
 fn bench_reports_json_and_applies_overrides() {
-    let st = slosh()
-        .args([
-            "bench",
-            "--case",
-            "seed_2d_dp8mm_dfsph",
-            "--duration",
-            "0.05",
-            "--set",
-            "particle_spacing=0.02",
-            "--json",
-        ])
-        .output()
-        .unwrap();
+    let st = small_bench(&[]);
     assert!(
         st.status.success(),
         "{}",
@@ -412,6 +398,10 @@ fn bench_reports_json_and_applies_overrides() {
     for k in ["unconverged_steps", "retried_steps"] {
         assert!(r[k].as_u64().is_some(), "{k}: {r}");
     }
+    // One run (no --repeat): the range of wall times is that run.
+    assert_eq!(r["repeats"], 1);
+    assert_eq!(r["wall_time_s_min"], r["wall_time_s"]);
+    assert_eq!(r["wall_time_s_max"], r["wall_time_s"]);
     // A misspelt setting is refused by name, not ignored.
     let st = slosh()
         .args([
