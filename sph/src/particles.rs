@@ -181,23 +181,15 @@ impl<const D: usize> Fluid<D> {
             cell,
             ..
         } = self;
+        // (Each array is permuted on its own, so the order within a half does not matter.)
+        let (half, half2) = (
+            pos.iter_mut().chain(vel).chain([rho, pressure, kappa]),
+            pos0.iter_mut().chain(vel0).chain([rho0, kappa_div]),
+        );
         rayon::join(
+            || half.for_each(|v| permute(v, dest, s, keep)),
             || {
-                for k in 0..D {
-                    permute(&mut pos[k], dest, s, keep);
-                    permute(&mut vel[k], dest, s, keep);
-                }
-                permute(rho, dest, s, keep);
-                permute(pressure, dest, s, keep);
-                permute(kappa, dest, s, keep);
-            },
-            || {
-                for k in 0..D {
-                    permute(&mut pos0[k], dest, s2, keep);
-                    permute(&mut vel0[k], dest, s2, keep);
-                }
-                permute(rho0, dest, s2, keep);
-                permute(kappa_div, dest, s2, keep);
+                half2.for_each(|v| permute(v, dest, s2, keep));
                 permute(id, dest, su, keep);
                 permute(cell, dest, su, keep);
             },
