@@ -45,6 +45,7 @@ pub mod params;
 pub mod particles;
 pub mod scheme;
 pub mod simulation;
+pub mod sloshing;
 pub mod tank;
 
 pub use error::SimError;
