@@ -981,13 +981,16 @@ impl Loaded {
     /// Every parameter as the run uses it, defaults included (`summary.json`'s and the recording's
     /// `effective_parameters`; `parameters` holds only those given): the configuration with `params`'
     /// particle spacing (a node's automatic resolution may have chosen it), the kernel gradient the scheme
-    /// takes when none is set, and the speed of sound the solver derived when none is set.
+    /// takes when none is set, the speed of sound the solver derived when none is set, and the incompressible
+    /// solver's relaxation when none is set.
     pub fn effective_parameters(&self, params: &SimParams) -> Value {
         let mut v = serde_json::to_value(&self.config).expect("the configuration serialises");
         v["particle_spacing"] = serde_json::json!(params.particle_spacing);
         v["solver"]["kernel_gradient"] =
             serde_json::to_value(params.solver.kernel_gradient()).expect("serialises");
         v["solver"]["sound_speed"] = serde_json::json!(params.sound_speed());
+        v["solver"]["dfsph"]["relaxation"] =
+            serde_json::json!(params.solver.dfsph.relaxation(params.gradients_corrected()));
         v
     }
 

@@ -280,7 +280,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 };
                 (0.6 * full) as u32
             },
-            relaxation: s.dfsph.relaxation as f32,
+            relaxation: s.dfsph.relaxation(params.gradients_corrected()) as f32,
+            corrected: params.gradients_corrected(),
         };
         let dt_min = if s.dt_min > 0.0 {
             s.dt_min
@@ -327,6 +328,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             bodies,
             spots,
         };
+        sim.dwork
+            .correct_gradients(sim.params.gradients_corrected());
         if !sim.bodies.is_empty() {
             sim.bodies.last_flooded = Some((0.0, sim.flooded_volumes()));
             // Bodies start from rest with forces the liquid has not balanced yet (a hole, a kick): the

@@ -96,14 +96,17 @@ fn run(p: &SimParams, ranks: usize) -> (Vec<Observation>, Liquid, u64) {
 
 #[test]
 fn ranks_as_threads_reproduce_one_process() {
-    for (scheme, method, obstacle) in [
-        (Scheme::Wcsph, BoundaryMethod::Dynamic, false),
-        (Scheme::Wcsph, BoundaryMethod::Mirror, false),
-        (Scheme::Dfsph, BoundaryMethod::Dynamic, false),
+    for (scheme, method, obstacle, corrected) in [
+        (Scheme::Wcsph, BoundaryMethod::Dynamic, false, false),
+        (Scheme::Wcsph, BoundaryMethod::Mirror, false, false),
+        (Scheme::Dfsph, BoundaryMethod::Dynamic, false, false),
+        // The corrected kernel gradients: halo copies take their owners' correction.
+        (Scheme::Dfsph, BoundaryMethod::Dynamic, false, true),
         // A block fixed to the floor across the middle cut: its wall particles on every rank.
-        (Scheme::Dfsph, BoundaryMethod::Dynamic, true),
+        (Scheme::Dfsph, BoundaryMethod::Dynamic, true, false),
     ] {
         let mut p = case(scheme, method);
+        p.solver.dfsph.kernel_correction = corrected;
         if obstacle {
             p.obstacles = vec![sph::body::RegionSpec {
                 name: "block".into(),
@@ -122,7 +125,9 @@ fn ranks_as_threads_reproduce_one_process() {
         );
         for ranks in [2, 3] {
             let (o, l, rebalances) = run(&p, ranks);
-            let what = format!("{scheme:?} {method:?} (obstacle: {obstacle}) on {ranks} ranks");
+            let what = format!(
+                "{scheme:?} {method:?} (obstacle: {obstacle}, corrected: {corrected}) on {ranks} ranks"
+            );
             assert_eq!(l, l1, "{what}: the liquid differs");
             assert_eq!(o.len(), o1.len());
             for (a, b) in o.iter().zip(&o1) {

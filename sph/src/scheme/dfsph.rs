@@ -30,6 +30,7 @@
 //! results do not depend on the number of threads.
 
 use super::candidates::{lane_sum, share_room, wide_lanes, Room, LANES};
+use super::gradient_correction::{self as correction, Mat};
 use super::half::Half4;
 use super::landing::landing_step;
 use super::near::Near;
@@ -75,6 +76,9 @@ pub struct Coefficients {
     /// The Jacobi iterations' relaxation ω: each takes ω times the step to its own particle's target
     /// (`solver.dfsph.relaxation`).
     pub relaxation: f32,
+    /// Whether the kernel gradients are corrected (`gradient_correction`): the neighbourhood pass then
+    /// sums the walls' part of each particle's M.
+    pub corrected: bool,
 }
 
 /// Neighbour lists of one chunk of liquid particles, with the kernel gradients ∇_a W_ab.
@@ -98,6 +102,9 @@ struct Lists<const D: usize> {
     gb: Vec<[f32; D]>,
     mb: Vec<[f32; 3]>,
     full: Vec<bool>,
+    /// Per particle: the walls' part of the gradient correction's M, Σ_b V_b (x_b − x_a) ⊗ ∇W_ab
+    /// (`gradient_correction`).
+    mw: Vec<Mat<D>>,
     /// Per particle: Σ_b m_b v_b·∇W_ab, what moving walls (floating bodies, a wave maker) add to the rate of
     /// change of its density (0 beside walls at rest).
     wf: Vec<f32>,
@@ -148,6 +155,11 @@ pub struct Workspace<const D: usize> {
     /// Start the constant-density solve from half the last pressure, not from its hydrostatic part
     /// ([`Workspace::plain_warm_start`]).
     plain_warm_start: bool,
+    /// Correct the kernel gradients (`gradient_correction`), and each particle's L = M⁻¹ when it does.
+    corrected: bool,
+    corr: Vec<Mat<D>>,
+    /// One component of `corr` at a time, for the halo exchange.
+    component: Vec<f32>,
 }
 
 /// What one step (or a priming solve) did.
@@ -196,6 +208,8 @@ struct Hood<const D: usize> {
     mb: [f32; 3],
     /// Σ_b m_b v_b·∇W_ab.
     wflux: f32,
+    /// Σ_b V_b (x_b − x_a) ⊗ ∇W_ab over the wall neighbours.
+    shape_b: Mat<D>,
     /// Liquid and wall neighbours within the support.
     liquid: u32,
     walls: u32,
@@ -211,6 +225,7 @@ struct HoodLanes<const D: usize> {
     wall: [[f32; LANES]; D],
     wflux: [f32; LANES],
     walls: [f32; LANES],
+    shape_b: [[[f32; LANES]; D]; D],
 }
 
 /// Where a particle's neighbours are: the rows of cells around it (ranges of the cell-sorted arrays) of the
@@ -251,6 +266,7 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
         wall: [z; D],
         wflux: z,
         walls: z,
+        shape_b: [[z; D]; D],
     };
     let first = j.len();
     // What the records hold: ∇W times this.
@@ -266,6 +282,7 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
     // Monaghan's Π_ab = −α c0 h min(v_ab·x_ab, 0) / ((r² + η²) ρ_rest): the constant factor of each.
     let visc = c.pair.alpha * c.pair.c0 * c.pair.h / c.rho_rest;
     let visc_b = c.pair.alpha_bound * c.pair.c0 * c.pair.h / c.rho_rest;
+    let vol_b = mw / c.rho_rest;
     for blk in 0..fs.blocks() {
         let (dxs, ws, idx) = fs.block(blk);
         let mut gl = [z; D];
@@ -352,6 +369,14 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
             // m_b v_b·∇W_ab = m_b F(r) v_b·(x_a − x_b)
             s.wflux[l] += mw * gf * ws[l];
             s.walls[l] += fin;
+            // V_b (x_b − x_a) ⊗ ∇W_ab = −V_b F(r) dx ⊗ dx
+            if c.corrected {
+                for r in 0..D {
+                    for q in 0..D {
+                        s.shape_b[r][q][l] -= vol_b * gf * dx[r] * dx[q];
+                    }
+                }
+            }
         }
     }
     let wall: [f32; D] = std::array::from_fn(|d| lane_sum(&s.wall[d]));
@@ -367,6 +392,7 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
         moment: cross(to3(xa), to3(wall)),
         mb: cross(to3(xa), to3(push)),
         wflux: lane_sum(&s.wflux),
+        shape_b: std::array::from_fn(|r| std::array::from_fn(|q| lane_sum(&s.shape_b[r][q]))),
         liquid: n as u32,
         walls: lane_sum(&s.walls) as u32,
     }
@@ -466,6 +492,7 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.wf.clear();
     lists.mb.clear();
     lists.full.clear();
+    lists.mw.clear();
     // The cell whose rows of neighbouring cells are in `liquid` and `walls`.
     let mut cell = u32::MAX;
     for o in 0..rho.len() {
@@ -481,6 +508,7 @@ fn build_chunk<const D: usize, K: Kernel>(
             lists.wf.push(0.0);
             lists.mb.push([0.0; 3]);
             lists.full.push(false);
+            lists.mw.push([[0.0; D]; D]);
             continue;
         }
         if f.cell[a] != cell {
@@ -515,27 +543,15 @@ fn build_chunk<const D: usize, K: Kernel>(
             (false, true) => hood::<D, 4, Half4, K>(p.k, c, own, around, near, j, gh, false),
             (false, false) => hood::<D, D, _, K>(p.k, c, own, around, near, j, g, false),
         };
-        let (grad, grad_b) = (hd.grad, hd.grad_b);
-        // The particle's own k changes its density through (Σ_f m∇W + Σ_b m∇W)·(Σ_f m∇W + 2 Σ_b m∇W): the
-        // walls push back with the mirrored pressure, k_b = k_a.
-        // (The Jacobi diagonal; kept positive where liquid and wall gradients oppose.)
-        let denom = (0..D)
-            .map(|d| (grad[d] + grad_b[d]) * (grad[d] + MIRROR * grad_b[d]))
-            .sum::<f32>()
-            .max(0.0)
-            + hd.sq;
         rho[o] = hd.density;
-        lists.gb.push(grad_b);
+        lists.gb.push(hd.grad_b);
         lists.wf.push(hd.wflux);
         lists.mb.push(hd.mb);
         lists
             .full
             .push(hd.liquid + hd.walls >= c.full_neighbourhood);
-        factor[o] = if denom > 1e-6 * c.pair.m_fluid * c.pair.m_fluid / (c.pair.h * c.pair.h) {
-            c.relaxation / denom
-        } else {
-            0.0
-        };
+        lists.mw.push(hd.shape_b);
+        factor[o] = dfsph_factor(c, hd.grad, hd.grad_b, hd.sq);
         let fa: [f32; D] = from3(p.frame.acceleration(to3(xa), to3(va)));
         let mut a2 = 0.0f32;
         let mut v2 = 0.0f32;
@@ -558,6 +574,98 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.start.push(lists.j.len() as u32);
     lists.end_j = lists.j.iter().max().map_or(0, |m| *m as usize + 1);
     out
+}
+
+/// The relaxed DFSPH factor ω / (|Σ_f m∇W + Σ_b m∇W|·… + Σ_f |m∇W|²) of a particle whose liquid and wall
+/// neighbours' gradients sum to `grad` and `grad_b` (times m) and whose liquid ones' squares to `sq`: its
+/// own k changes its density through (Σ_f m∇W + Σ_b m∇W)·(Σ_f m∇W + MIRROR Σ_b m∇W) (the walls push back
+/// with the particle's own k). The Jacobi diagonal, kept positive where liquid and wall gradients oppose;
+/// 0 where it vanishes (a lone particle).
+fn dfsph_factor<const D: usize>(
+    c: &Coefficients,
+    grad: [f32; D],
+    grad_b: [f32; D],
+    sq: f32,
+) -> f32 {
+    let denom = (0..D)
+        .map(|d| (grad[d] + grad_b[d]) * (grad[d] + MIRROR * grad_b[d]))
+        .sum::<f32>()
+        .max(0.0)
+        + sq;
+    if denom > 1e-6 * c.pair.m_fluid * c.pair.m_fluid / (c.pair.h * c.pair.h) {
+        c.relaxation / denom
+    } else {
+        0.0
+    }
+}
+
+/// Correction pass, first half, for one chunk: each particle's L (`gradient_correction`) from its liquid
+/// neighbours' records and positions and its walls' part `mw` (halo copies' are replaced by their owners'
+/// afterwards).
+fn correction_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
+    c: &Coefficients,
+    (lists, g): (&Lists<D>, &[R]),
+    x: &[Vec<f32>; D],
+    first: usize,
+    out: &mut [Mat<D>],
+) {
+    let vol = c.pair.m_fluid / c.rho_rest;
+    let unscale = 1.0 / R::scale(c.pair.h);
+    for (o, l) in out.iter_mut().enumerate() {
+        let a = first + o;
+        let mut m = lists.mw[o];
+        let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
+        for q in lo..hi {
+            let b = lists.j[q] as usize;
+            let lanes = g[q].lanes();
+            let gr: [f32; D] = std::array::from_fn(|d| lanes[d] * unscale);
+            let dx: [f32; D] = std::array::from_fn(|d| x[d][b] - x[d][a]);
+            correction::add_pair(&mut m, vol, dx, gr);
+        }
+        *l = correction::inverse_or_identity(&m);
+    }
+}
+
+/// Correction pass, second half, for one chunk: every record ∇W_ab becomes ½(L_a + L_b)∇W_ab, the walls'
+/// Σ m_b∇W_ab becomes L_a Σ m_b∇W_ab (and its moment with it), and the DFSPH factor is made again from the
+/// corrected gradients.
+fn corrected_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
+    c: &Coefficients,
+    lists: &mut Lists<D>,
+    g: &mut [R],
+    corr: &[Mat<D>],
+    x: &[Vec<f32>; D],
+    first: usize,
+    factor: &mut [f32],
+) {
+    let m = c.pair.m_fluid;
+    let unscale = 1.0 / R::scale(c.pair.h);
+    for (o, f) in factor.iter_mut().enumerate() {
+        let a = first + o;
+        let la = &corr[a];
+        let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
+        let (mut grad, mut sq) = ([0.0f32; D], 0.0f32);
+        for q in lo..hi {
+            let b = lists.j[q] as usize;
+            let lanes = g[q].lanes();
+            let gr: [f32; D] = std::array::from_fn(|d| lanes[d]);
+            let gc = correction::apply(&correction::mean(la, &corr[b]), gr);
+            g[q] = R::pack(gc);
+            let back = g[q].lanes();
+            for d in 0..D {
+                let gd = m * back[d] * unscale;
+                grad[d] += gd;
+                sq += gd * gd;
+            }
+        }
+        let gb = correction::apply(la, lists.gb[o]);
+        lists.gb[o] = gb;
+        let xa: [f32; D] = std::array::from_fn(|d| x[d][a]);
+        let push: [f32; D] = std::array::from_fn(|d| -MIRROR * gb[d]);
+        lists.mb[o] = cross(to3(xa), to3(push));
+        // (0 for halo copies and lone particles, which have no neighbours: as in the first pass.)
+        *f = dfsph_factor(c, grad, gb, sq);
+    }
 }
 
 /// Which error a solve removes.
@@ -770,6 +878,65 @@ impl<const D: usize> Workspace<D> {
         self.k.resize(n, 0.0);
         self.ksum.resize(n, 0.0);
         self.vel4.resize(if D == 3 { n } else { 0 }, [0.0; 4]);
+    }
+
+    /// Turns the kernel gradient correction on or off (`solver.dfsph.kernel_correction`; off with bodies).
+    pub fn correct_gradients(&mut self, on: bool) {
+        self.corrected = on;
+    }
+
+    /// The correction pass (after pass 1): every particle's L, its halo copies' from their owners, then the
+    /// corrected records, wall sums and factors.
+    fn correct<K: Kernel>(&mut self, p: &Ctx<'_, D, K>, ranks: Option<&mut (dyn Ranks<D> + '_)>) {
+        let Workspace {
+            lists,
+            factor,
+            corr,
+            component,
+            ..
+        } = self;
+        let (c, x) = (p.c, &p.fluid.x);
+        corr.resize(factor.len(), correction::identity());
+        corr.par_chunks_mut(CHUNK)
+            .zip(lists.par_iter())
+            .enumerate()
+            .for_each(|(ci, (out, l))| {
+                if D == 3 {
+                    correction_chunk(c, (l, &l.gh), x, ci * CHUNK, out)
+                } else {
+                    correction_chunk(c, (l, &l.g), x, ci * CHUNK, out)
+                }
+            });
+        if let Some(r) = ranks {
+            component.resize(corr.len(), 0.0);
+            for row in 0..D {
+                for col in 0..D {
+                    for (v, m) in component.iter_mut().zip(corr.iter()) {
+                        *v = m[row][col];
+                    }
+                    r.sync_scalar(component);
+                    for (v, m) in component.iter().zip(corr.iter_mut()) {
+                        m[row][col] = *v;
+                    }
+                }
+            }
+        }
+        let corr = &*corr;
+        factor
+            .par_chunks_mut(CHUNK)
+            .zip(lists.par_iter_mut())
+            .enumerate()
+            .for_each(|(ci, (f, l))| {
+                if D == 3 {
+                    let mut gh = std::mem::take(&mut l.gh);
+                    corrected_chunk(c, l, &mut gh, corr, x, ci * CHUNK, f);
+                    l.gh = gh;
+                } else {
+                    let mut g = std::mem::take(&mut l.g);
+                    corrected_chunk(c, l, &mut g, corr, x, ci * CHUNK, f);
+                    l.g = g;
+                }
+            });
     }
 
     /// Pass 1 over all particles; returns the merged totals.
@@ -1015,6 +1182,9 @@ pub fn step<'r, const D: usize, K: Kernel>(
         || columns.warm_start(grid, p.fluid, setting, &mut start),
     );
     work.columns = columns;
+    if work.corrected {
+        work.correct(&p, ranks.as_deref_mut());
+    }
     let mut report = StepReport {
         totals: built.totals,
         ..Default::default()
@@ -1317,6 +1487,7 @@ mod tests {
             rho_rest: 1000.0,
             full_neighbourhood: 1,
             relaxation: 1.0,
+            corrected: false,
         };
         // A jittered lattice of 7^D liquid particles with made-up velocities, and a row of wall particles
         // through its lower half.

@@ -3,6 +3,7 @@
 
 pub mod candidates;
 pub mod dfsph;
+pub mod gradient_correction;
 pub mod half;
 pub mod landing;
 pub mod near;

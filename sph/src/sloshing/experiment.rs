@@ -4,7 +4,7 @@
 
 use super::signal::{self, Decay};
 use super::theory::{LaminarDamping, Tank};
-use crate::motion::{AtRest, RegularDof, RegularMotion, TankMotion};
+use crate::motion::{AtRest, Dof6, Dof6Motion, RegularDof, RegularMotion, TankMotion};
 use crate::params::SimParams;
 use crate::{SimError, Solver};
 use std::f64::consts::PI;
@@ -112,7 +112,7 @@ pub fn free_decay(
         o.wrench.force[0]
     })?;
     let skip = times.iter().position(|&t| t >= period).unwrap_or(0);
-    let decay = signal::free_decay(&times[skip..], &force[skip..], 0.0, period, 0.05)?;
+    let decay = signal::free_decay(&times[skip..], &force[skip..], period)?;
     Ok(FreeDecay {
         wall_time: clock.elapsed().as_secs_f64(),
         simulated: cycles * period,
@@ -241,5 +241,81 @@ pub fn forced(
         response,
         wall_time: clock.elapsed().as_secs_f64(),
         simulated: t_end,
+    })
+}
+
+/// A tank held pitched: the liquid's mean force and moment, and the mean probe heights.
+#[derive(Clone, Debug)]
+pub struct Tilted {
+    /// Pitch, rad.
+    pub theta: f64,
+    /// Mean force (N) and moment about y (N·m) of the liquid on the tank, tank frame.
+    pub force: [f64; 3],
+    pub moment: f64,
+    /// The weight through the tilted liquid's centroid (`Tank::tilted_moment`), and the weight m g.
+    pub theory_moment: f64,
+    pub weight: f64,
+    /// Mean height of each probe of the parameters, m.
+    pub probes: Vec<f64>,
+}
+
+/// Pitch θ reached smoothly over `ramp` s (a half-cosine) and then held.
+struct Tilt {
+    theta: f64,
+    ramp: f64,
+}
+
+impl Dof6Motion for Tilt {
+    fn dof(&self, t: f64) -> Dof6 {
+        let mut d = Dof6::default();
+        let (r, dr, ddr) = crate::motion::ramp(t, self.ramp);
+        d.q[4] = self.theta * r;
+        d.dq[4] = self.theta * dr;
+        d.ddq[4] = self.theta * ddr;
+        d
+    }
+}
+
+/// Tilts the tank by `theta` (pitch, rad) over `ramp` s and averages the wrench and the probes over the
+/// `periods` first-mode periods (of linear theory) after `settle` more seconds: whole periods, so that what
+/// is left of the sloshing the tilt started averages out.
+pub fn tilted(
+    params: SimParams,
+    theta: f64,
+    ramp: f64,
+    settle: f64,
+    periods: f64,
+) -> Result<Tilted, ExperimentError> {
+    let tank = theory_tank(&params);
+    let motion = Tilt { theta, ramp };
+    let mut sim = crate::build(params)?;
+    let from = ramp + settle;
+    let to = from + periods * tank.natural_period(1);
+    let n_probes = sim.params().probes.len();
+    let (mut force, mut moment, mut probes, mut n) = ([0.0; 3], 0.0, vec![0.0; n_probes], 0.0);
+    let steps = (to / SAMPLE).round() as usize;
+    for i in 1..=steps {
+        let t = i as f64 * SAMPLE;
+        sim.advance_to(&motion, t)?;
+        if t < from {
+            continue;
+        }
+        let o = sim.observe(&motion)?;
+        for k in 0..3 {
+            force[k] += o.wrench.force[k];
+        }
+        moment += o.wrench.moment[1];
+        for (p, v) in probes.iter_mut().zip(&o.probes) {
+            *p += v;
+        }
+        n += 1.0;
+    }
+    Ok(Tilted {
+        theta,
+        force: force.map(|f| f / n),
+        moment: moment / n,
+        theory_moment: tank.tilted_moment(theta),
+        weight: tank.liquid_mass() * tank.gravity,
+        probes: probes.into_iter().map(|p| p / n).collect(),
     })
 }

@@ -1,4 +1,4 @@
-//! Reading a sloshing record: the period and damping of a free decay (from its successive extrema), and the
+//! Reading a sloshing record: the period and damping of a free decay (a damped sine fitted to it), and the
 //! amplitude and phase of a forced response at its forcing frequency (a least-squares fit of sines).
 
 use std::f64::consts::PI;
@@ -6,14 +6,13 @@ use std::f64::consts::PI;
 /// What a free decay record says about its mode.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Decay {
-    /// Period, s: twice the slope of the extrema's times against their count.
+    /// Damped period 2π/ω_d, s.
     pub period: f64,
-    /// Damping ratio ζ from the logarithmic decrement δ per cycle (the slope of ln|extremum| against the
-    /// count of half cycles, fitted over all of them): ζ = δ / sqrt(4π² + δ²).
+    /// Damping ratio ζ (the logarithmic decrement per cycle is δ = 2πζ / sqrt(1 − ζ²)).
     pub damping_ratio: f64,
-    /// Whole cycles the fit spans.
+    /// Cycles the record spans.
     pub cycles: f64,
-    /// The first and last extremum's magnitude.
+    /// The fitted amplitude at the record's start and end.
     pub first_amplitude: f64,
     pub last_amplitude: f64,
 }
@@ -30,83 +29,110 @@ impl std::fmt::Display for SignalError {
 
 impl std::error::Error for SignalError {}
 
-/// Least-squares line y = a + b x: (a, b).
-fn line(x: &[f64], y: &[f64]) -> (f64, f64) {
-    let n = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
-    let b = sxy / sxx;
-    (my - b * mx, b)
-}
-
-/// Period and damping of the decaying oscillation in `y` (sampled at the uniformly spaced times `t`) about
-/// `equilibrium`, expected near `period_guess` s. The record is smoothed over `smooth` s (a centred running
-/// mean: it scales every extremum alike and keeps their times), and its extrema are taken as the largest
-/// |y| within a quarter period either side, refined by a parabola through their neighbours.
-pub fn free_decay(
-    t: &[f64],
-    y: &[f64],
-    equilibrium: f64,
-    period_guess: f64,
-    smooth: f64,
-) -> Result<Decay, SignalError> {
-    if t.len() != y.len() || t.len() < 8 {
+/// Period and damping of the decaying oscillation in `y` (sampled at times `t`), expected near
+/// `period_guess` s: the least-squares fit of y ≈ e^(−σt)(a cos ω_d t + b sin ω_d t) + c over the whole
+/// record (ω_d and σ searched on a grid, then refined; a, b, c linear). Fitting the whole record, not its
+/// extrema, keeps step-to-step noise from inflating the peaks. ζ = σ / sqrt(σ² + ω_d²).
+pub fn free_decay(t: &[f64], y: &[f64], period_guess: f64) -> Result<Decay, SignalError> {
+    if t.len() != y.len() || t.len() < 16 {
         return Err(SignalError(format!("{} samples: too few", t.len())));
     }
-    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-    let half = ((smooth / dt / 2.0).round() as usize).max(0);
-    let n = y.len();
-    let s: Vec<f64> = (0..n)
-        .map(|i| {
-            let (a, b) = (i.saturating_sub(half), (i + half + 1).min(n));
-            y[a..b].iter().sum::<f64>() / (b - a) as f64 - equilibrium
-        })
-        .collect();
-    let reach = ((period_guess / 4.0 / dt).round() as usize).max(1);
-    // Extrema whose neighbourhood lies wholly in the record (and beyond the smoothing's edge).
-    let edge = reach.max(half + 1);
-    let mut ext: Vec<(f64, f64)> = vec![];
-    for i in edge..n.saturating_sub(edge) {
-        let m = s[i].abs();
-        if m == 0.0 || s[i - reach..=i + reach].iter().any(|v| v.abs() > m) {
-            continue;
-        }
-        // Only alternating signs (a flat top seen twice counts once).
-        if let Some(&(_, last)) = ext.last() {
-            if last.signum() == s[i].signum() {
-                continue;
-            }
-        }
-        let (a, b, c) = (s[i - 1], s[i], s[i + 1]);
-        let curv = a - 2.0 * b + c;
-        let off = if curv != 0.0 {
-            0.5 * (a - c) / curv
-        } else {
-            0.0
-        };
-        let off = off.clamp(-0.5, 0.5);
-        ext.push((t[i] + off * dt, b - 0.25 * (a - c) * off));
-    }
-    if ext.len() < 5 {
+    let span = t[t.len() - 1] - t[0];
+    let cycles = span / period_guess;
+    if cycles < 3.0 {
         return Err(SignalError(format!(
-            "{} extrema in the record: at least five half cycles are needed",
-            ext.len()
+            "the record spans {cycles:.1} periods: at least three are needed"
         )));
     }
-    let count: Vec<f64> = (0..ext.len()).map(|i| i as f64).collect();
-    let times: Vec<f64> = ext.iter().map(|e| e.0).collect();
-    let logs: Vec<f64> = ext.iter().map(|e| e.1.abs().ln()).collect();
-    let (_, half_period) = line(&count, &times);
-    let (_, slope) = line(&count, &logs);
-    let delta = -2.0 * slope;
+    let t0 = t[0];
+    let w0 = 2.0 * PI / period_guess;
+    // Residual and coefficients of the linear fit at (ω, σ).
+    let fit = |w: f64, s: f64| -> (f64, [f64; 3]) {
+        let mut a = [[0.0f64; 4]; 3];
+        for (&ti, &yi) in t.iter().zip(y) {
+            let tt = ti - t0;
+            let e = (-s * tt).exp();
+            let b = [e * (w * tt).cos(), e * (w * tt).sin(), 1.0];
+            for r in 0..3 {
+                for c in 0..3 {
+                    a[r][c] += b[r] * b[c];
+                }
+                a[r][3] += b[r] * yi;
+            }
+        }
+        let x = solve3(a);
+        let res: f64 = t
+            .iter()
+            .zip(y)
+            .map(|(&ti, &yi)| {
+                let tt = ti - t0;
+                let e = (-s * tt).exp();
+                let m = e * (x[0] * (w * tt).cos() + x[1] * (w * tt).sin()) + x[2];
+                (yi - m).powi(2)
+            })
+            .sum();
+        (res, x)
+    };
+    // Grid: ω within ±20 % of the guess, σ from −0.05 ω to 0.3 ω.
+    let (mut best, mut bw, mut bs) = (f64::INFINITY, w0, 0.0);
+    for i in 0..=80 {
+        let w = w0 * (0.8 + 0.4 * i as f64 / 80.0);
+        for j in 0..=35 {
+            let s = w0 * (-0.05 + 0.35 * j as f64 / 35.0);
+            let (r, _) = fit(w, s);
+            if r < best {
+                (best, bw, bs) = (r, w, s);
+            }
+        }
+    }
+    // Refine by shrinking coordinate steps.
+    let (mut dw, mut ds) = (0.4 * w0 / 80.0, 0.35 * w0 / 35.0);
+    for _ in 0..60 {
+        let mut moved = false;
+        for (cw, cs) in [(dw, 0.0), (-dw, 0.0), (0.0, ds), (0.0, -ds)] {
+            let (r, _) = fit(bw + cw, bs + cs);
+            if r < best {
+                (best, bw, bs) = (r, bw + cw, bs + cs);
+                moved = true;
+            }
+        }
+        if !moved {
+            dw *= 0.5;
+            ds *= 0.5;
+        }
+    }
+    let (_, x) = fit(bw, bs);
+    let amp = x[0].hypot(x[1]);
     Ok(Decay {
-        period: 2.0 * half_period,
-        damping_ratio: delta / (4.0 * PI * PI + delta * delta).sqrt(),
-        cycles: (ext.len() - 1) as f64 / 2.0,
-        first_amplitude: ext[0].1.abs(),
-        last_amplitude: ext[ext.len() - 1].1.abs(),
+        period: 2.0 * PI / bw,
+        damping_ratio: bs / bs.hypot(bw),
+        cycles: span * bw / (2.0 * PI),
+        first_amplitude: amp,
+        last_amplitude: amp * (-bs * span).exp(),
     })
+}
+
+/// Solves the 3×3 system held as an augmented matrix (partial pivoting).
+fn solve3(mut a: [[f64; 4]; 3]) -> [f64; 3] {
+    for col in 0..3 {
+        let p = (col..3)
+            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
+            .unwrap();
+        a.swap(col, p);
+        let d = a[col][col];
+        if d == 0.0 {
+            return [0.0; 3];
+        }
+        for r in 0..3 {
+            if r != col {
+                let f = a[r][col] / d;
+                for c in col..4 {
+                    a[r][c] -= f * a[col][c];
+                }
+            }
+        }
+    }
+    [a[0][3] / a[0][0], a[1][3] / a[1][1], a[2][3] / a[2][2]]
 }
 
 /// Amplitude and phase of `y` at `w` (rad/s): y ≈ amplitude · sin(w t + phase) + (sines at `others`) + a
@@ -179,7 +205,7 @@ mod tests {
             .iter()
             .map(|&t| 3.0 + 2.0 * (-zeta * w * t).exp() * (wd * t + 0.3).cos())
             .collect();
-        let d = free_decay(&t, &y, 3.0, 1.2, 0.05).unwrap();
+        let d = free_decay(&t, &y, 1.2).unwrap();
         assert!((d.period - 2.0 * PI / wd).abs() < 1e-4 * d.period, "{d:?}");
         assert!((d.damping_ratio - zeta).abs() < 1e-4, "{d:?}");
         assert!(d.cycles > 6.0, "{d:?}");
@@ -201,6 +227,6 @@ mod tests {
     fn too_short_a_record_is_refused() {
         let t: Vec<f64> = (0..100).map(|i| i as f64 * 0.01).collect();
         let y: Vec<f64> = t.iter().map(|t| (5.0 * t).sin()).collect();
-        assert!(free_decay(&t, &y, 0.0, 1.25, 0.0).is_err());
+        assert!(free_decay(&t, &y, 1.25).is_err());
     }
 }

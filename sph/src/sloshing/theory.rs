@@ -168,6 +168,16 @@ impl Tank {
         let (l, h) = (self.length, self.depth);
         self.liquid_mass() * self.gravity * theta * (h / 2.0 + l * l / (12.0 * h))
     }
+
+    /// The same at any angle whose level surface z = h + x tan θ (tank frame) stays clear of the floor and
+    /// the top: the weight m g (sin θ, 0, −cos θ) in the tank frame through the centroid
+    /// (tan θ L²/(12h), h/2 + tan²θ L²/(24h)).
+    pub fn tilted_moment(&self, theta: f64) -> f64 {
+        let (l, h) = (self.length, self.depth);
+        let t = theta.tan();
+        let (xc, zc) = (t * l * l / (12.0 * h), h / 2.0 + t * t * l * l / (24.0 * h));
+        self.liquid_mass() * self.gravity * (zc * theta.sin() + xc * theta.cos())
+    }
 }
 
 #[cfg(test)]
@@ -237,6 +247,13 @@ mod tests {
             let s = t.static_pitch_moment(1.0);
             assert!((m / s - 1.0).abs() < 1e-6, "{m} against {s}");
         }
+    }
+
+    #[test]
+    fn a_small_tilt_is_the_linear_one() {
+        let t = seed(0.19);
+        let (a, b) = (t.tilted_moment(1e-3), t.static_pitch_moment(1e-3));
+        assert!((a / b - 1.0).abs() < 1e-5, "{a} against {b}");
     }
 
     #[test]
