@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod config;
 pub mod iox;
+pub mod mcap_bounds;
 pub mod memory;
 pub mod motion_source;
 pub mod output;

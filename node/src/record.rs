@@ -501,11 +501,22 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
         // reads as damaged to the MCAP reader's checks, not as valid messages.
         let bytes =
             unsafe { memmap2::Mmap::map(&f) }.map_err(|e| bad(file, format!("cannot map: {e}")))?;
+        // A chunk claiming an impossible size ends what is recovered (the reader would try to allocate it).
+        let oversized = crate::mcap_bounds::first_oversized_chunk(&bytes);
+        let readable = oversized.map_or(&bytes[..], |o| &bytes[..o.offset]);
         let stream = mcap::MessageStream::new_with_options(
-            &bytes,
+            readable,
             mcap::read::Options::IgnoreEndMagic.into(),
         )
         .map_err(|e| bad(file, format!("not an MCAP file: {e}")))?;
+        let mut stopped = false;
+        let where_ = |file: &Path, why: String| {
+            if files.len() > 1 {
+                format!("{}: {why}", file.display())
+            } else {
+                why
+            }
+        };
         for m in stream {
             match m {
                 Ok(m) => {
@@ -520,14 +531,16 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
                     n += 1;
                 }
                 Err(e) => {
-                    stops.push(if files.len() > 1 {
-                        format!("{}: {e}", file.display())
-                    } else {
-                        e.to_string()
-                    });
+                    // (Where a chunk claimed an impossible size the read part ends there: that is why.)
+                    let why = oversized.map_or_else(|| e.to_string(), |o| o.to_string());
+                    stops.push(where_(file, why));
+                    stopped = true;
                     break;
                 }
             }
+        }
+        if let (false, Some(o)) = (stopped, oversized) {
+            stops.push(where_(file, o.to_string()));
         }
     }
     let topics = rec.channels.len();
@@ -561,8 +574,10 @@ fn surviving_parameters(file: &Path) -> Option<BTreeMap<String, String>> {
     let f = std::fs::File::open(file).ok()?;
     // SAFETY: only read while this function runs (as in `repair`).
     let bytes = unsafe { memmap2::Mmap::map(&f) }.ok()?;
+    let readable = crate::mcap_bounds::first_oversized_chunk(&bytes)
+        .map_or(&bytes[..], |o| &bytes[..o.offset]);
     let reader = mcap::read::LinearReader::new_with_options(
-        &bytes,
+        readable,
         mcap::read::Options::IgnoreEndMagic.into(),
     )
     .ok()?;

@@ -262,6 +262,30 @@ fn damaged_and_ambiguous_bags_get_errors_naming_the_problem() {
         &[],
         &["truncated or corrupt", "slosh bag repair"],
     );
+    // A flipped bit in a chunk's stated uncompressed size (bit 57: 2^57 bytes, which the MCAP reader
+    // allocated and aborted the process on) is refused with an error, not an abort.
+    let flipped = dir.join("flipped.mcap");
+    let mut bytes = bytes.clone();
+    let (mut at, mut chunk) = (8usize, None);
+    while at + 9 <= bytes.len() && bytes[at] != 0x0F {
+        if bytes[at] == 0x06 {
+            chunk = Some(at);
+            break;
+        }
+        at += 9 + u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+    }
+    let chunk = chunk.expect("the bag is chunked");
+    bytes[chunk + 9 + 16 + 7] ^= 0x02;
+    std::fs::write(&flipped, &bytes).unwrap();
+    fails(
+        &flipped,
+        &[],
+        &[
+            "truncated or corrupt",
+            &format!("the chunk at byte {chunk} claims"),
+            "slosh bag repair",
+        ],
+    );
     let text = dir.join("text.mcap");
     std::fs::write(&text, "time,x\n0,0\n").unwrap();
     fails(&text, &[], &["not an MCAP file"]);

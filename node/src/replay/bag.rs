@@ -121,18 +121,36 @@ pub fn for_each_message(
                 "not an MCAP file (it does not start with the MCAP magic bytes); slosh reads rosbag2 bags stored as MCAP",
             ));
         }
-        let stream = mcap::MessageStream::new(&map).map_err(|e| {
+        // A chunk claiming an impossible size ends what is read (the reader would try to allocate it).
+        let oversized = crate::mcap_bounds::first_oversized_chunk(&map);
+        let readable = oversized.map_or(&map[..], |o| &map[..o.offset]);
+        let options = if oversized.is_some() {
+            mcap::read::Options::IgnoreEndMagic.into()
+        } else {
+            Default::default()
+        };
+        let stream = mcap::MessageStream::new_with_options(readable, options).map_err(|e| {
             BagError::new(
                 file,
                 format!("not an MCAP file ({e}); slosh reads rosbag2 bags stored as MCAP"),
             )
         })?;
-        for (n, m) in stream.enumerate() {
-            let m = m.map_err(|e| {
-                BagError::new(
+        let mut n = 0;
+        for next in stream.map(Some).chain(std::iter::once(None)) {
+            let cause = match (next, oversized) {
+                (Some(Ok(m)), _) => {
+                    visit(&m)?;
+                    n += 1;
+                    continue;
+                }
+                (None, None) => break,
+                (Some(Err(_)) | None, Some(o)) => o.to_string(),
+                (Some(Err(e)), None) => e.to_string(),
+            };
+            return Err(BagError::new(
                     file,
                     format!(
-                        "truncated or corrupt after {n} messages ({e}); `slosh bag repair {}` recovers the messages of its complete chunks into a new bag",
+                        "truncated or corrupt after {n} messages ({cause}); `slosh bag repair {}` recovers the messages of its complete chunks into a new bag",
                         // A rosbag2 folder is repaired whole (a split bag's other files' messages too), into a
                         // new folder beside it, not inside it.
                         match file.parent() {
@@ -144,9 +162,7 @@ pub fn for_each_message(
                             _ => file.display(),
                         }
                     ),
-                )
-            })?;
-            visit(&m)?;
+                ));
         }
     }
     Ok(())
