@@ -7,32 +7,7 @@
 //!     cargo run --release -p sph --example sloshing_accuracy -- --quick # 2D at 16 mm only
 use sph::kernel::KernelKind;
 use sph::params::*;
-use sph::sloshing::experiment::free_decay;
-
-/// The seed tank (0.8 × 0.25 × 0.6 m) filled to `fill` at spacing `dp`.
-fn seed(dim: usize, fill: f64, dp: f64) -> SimParams {
-    SimParams {
-        dimension: dim,
-        tank: TankSpec {
-            length: 0.8,
-            breadth: 0.25,
-            height: 0.6,
-        },
-        fill: FillSpec {
-            height: fill,
-            length: 0.0,
-        },
-        particle_spacing: dp,
-        fluid: FluidSpec::default(),
-        gravity: 9.81,
-        solver: SolverSpec::default(),
-        probes: vec![],
-        pressure_sensors: vec![],
-        bodies: vec![],
-        wave_maker: None,
-        obstacles: vec![],
-    }
-}
+use sph::sloshing::experiment::{free_decay, seed_tank as seed};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

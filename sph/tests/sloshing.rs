@@ -9,14 +9,14 @@
 
 use sph::kernel::KernelKind;
 use sph::params::*;
-use sph::sloshing::experiment::{forced, free_decay, tilted, Forcing};
+use sph::sloshing::experiment::{forced, free_decay, seed_tank, tilted, Forcing};
 
 mod common;
-use common::{probe, tank2d};
+use common::probe;
 
 /// The 2D seed tank filled to `fill`, dp 8 mm, with the setting under test.
 fn seed(fill: f64) -> SimParams {
-    let mut p = tank2d(0.8, 0.6, fill, 0.008);
+    let mut p = seed_tank(2, fill, 0.008);
     p.solver.scheme = Scheme::Dfsph;
     p.solver.kernel = KernelKind::Wendland;
     p.solver.dfsph.kernel_correction = true;

@@ -124,33 +124,27 @@ mod tests {
         m
     }
 
+    /// L M = I for the lattice sheared by `s`.
+    fn inverts<const D: usize>(s: f32) {
+        let m = lattice_m::<D>(0.01, s);
+        let l = inverse_or_identity(&m);
+        for r in 0..D {
+            for c in 0..D {
+                let lm: f32 = (0..D).map(|k| l[r][k] * m[k][c]).sum();
+                let want = if r == c { 1.0 } else { 0.0 };
+                assert!(
+                    (lm - want).abs() < 1e-4,
+                    "{D}D shear {s}: L M = {lm} at {r}{c}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn corrected_gradients_reproduce_the_identity_in_a_sheared_lattice() {
         for s in [0.0f32, 0.1, 0.25] {
-            let m2 = lattice_m::<2>(0.01, s);
-            let l2 = inverse_or_identity(&m2);
-            for r in 0..2 {
-                for c in 0..2 {
-                    let lm: f32 = (0..2).map(|k| l2[r][k] * m2[k][c]).sum();
-                    let want = if r == c { 1.0 } else { 0.0 };
-                    assert!(
-                        (lm - want).abs() < 1e-4,
-                        "2D shear {s}: L M = {lm} at {r}{c}"
-                    );
-                }
-            }
-            let m3 = lattice_m::<3>(0.01, s);
-            let l3 = inverse_or_identity(&m3);
-            for r in 0..3 {
-                for c in 0..3 {
-                    let lm: f32 = (0..3).map(|k| l3[r][k] * m3[k][c]).sum();
-                    let want = if r == c { 1.0 } else { 0.0 };
-                    assert!(
-                        (lm - want).abs() < 1e-4,
-                        "3D shear {s}: L M = {lm} at {r}{c}"
-                    );
-                }
-            }
+            inverts::<2>(s);
+            inverts::<3>(s);
         }
         // The uncorrected M of the unsheared lattice is near the identity already.
         let m = lattice_m::<2>(0.01, 0.0);
