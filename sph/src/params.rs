@@ -363,6 +363,29 @@ fn non_negative(field: &str, v: f64) -> Result<(), ParamError> {
 }
 
 impl SimParams {
+    /// A closed `tank` filled to `fill` m over its whole length at spacing `dp`, in `dimension` 2 or 3,
+    /// with the default fluid (water), gravity 9.81 m/s² and solver, and no probes, sensors, bodies, wave
+    /// maker or obstacles.
+    pub fn filled_tank(dimension: usize, tank: TankSpec, fill: f64, dp: f64) -> Self {
+        SimParams {
+            dimension,
+            tank,
+            fill: FillSpec {
+                height: fill,
+                length: 0.0,
+            },
+            particle_spacing: dp,
+            fluid: FluidSpec::default(),
+            gravity: 9.81,
+            solver: SolverSpec::default(),
+            probes: vec![],
+            pressure_sensors: vec![],
+            bodies: vec![],
+            wave_maker: None,
+            obstacles: vec![],
+        }
+    }
+
     /// Whether the incompressible scheme corrects its kernel gradients: `solver.dfsph.kernel_correction`,
     /// without bodies (floating bodies, fixed or not, a wave maker), whose moving walls it does not cover.
     pub fn gradients_corrected(&self) -> bool {

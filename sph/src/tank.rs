@@ -184,27 +184,12 @@ mod tests {
     use crate::params::*;
 
     fn params(dim: usize) -> SimParams {
-        SimParams {
-            dimension: dim,
-            tank: TankSpec {
-                length: 0.8,
-                breadth: 0.25,
-                height: 0.6,
-            },
-            fill: FillSpec {
-                height: 0.39,
-                length: 0.0,
-            },
-            particle_spacing: 0.02,
-            fluid: FluidSpec::default(),
-            gravity: 9.81,
-            solver: SolverSpec::default(),
-            probes: vec![],
-            pressure_sensors: vec![],
-            bodies: vec![],
-            wave_maker: None,
-            obstacles: vec![],
-        }
+        let tank = TankSpec {
+            length: 0.8,
+            breadth: 0.25,
+            height: 0.6,
+        };
+        SimParams::filled_tank(dim, tank, 0.39, 0.02)
     }
 
     #[test]

@@ -45,28 +45,12 @@ impl From<signal::SignalError> for ExperimentError {
 /// The seed case's tank (0.8 × 0.25 × 0.6 m, the paper's barge tank) filled to `fill` at spacing `dp`, in
 /// `dimension` 2 or 3, with the default solver and no probes, sensors or bodies.
 pub fn seed_tank(dimension: usize, fill: f64, dp: f64) -> SimParams {
-    use crate::params::{FillSpec, FluidSpec, SolverSpec, TankSpec};
-    SimParams {
-        dimension,
-        tank: TankSpec {
-            length: 0.8,
-            breadth: 0.25,
-            height: 0.6,
-        },
-        fill: FillSpec {
-            height: fill,
-            length: 0.0,
-        },
-        particle_spacing: dp,
-        fluid: FluidSpec::default(),
-        gravity: 9.81,
-        solver: SolverSpec::default(),
-        probes: vec![],
-        pressure_sensors: vec![],
-        bodies: vec![],
-        wave_maker: None,
-        obstacles: vec![],
-    }
+    let tank = crate::params::TankSpec {
+        length: 0.8,
+        breadth: 0.25,
+        height: 0.6,
+    };
+    SimParams::filled_tank(dimension, tank, fill, dp)
 }
 
 /// Linear theory's tank for these parameters: the tank's length and breadth, the fill as the depth.

@@ -8,27 +8,12 @@ pub const G: f64 = 9.81;
 
 /// A 2D tank (0.25 m broad) filled to `fill` at spacing `dp`, default solver, no probes, sensors or bodies.
 pub fn tank2d(length: f64, height: f64, fill: f64, dp: f64) -> SimParams {
-    SimParams {
-        dimension: 2,
-        tank: TankSpec {
-            length,
-            breadth: 0.25,
-            height,
-        },
-        fill: FillSpec {
-            height: fill,
-            length: 0.0,
-        },
-        particle_spacing: dp,
-        fluid: FluidSpec::default(),
-        gravity: G,
-        solver: SolverSpec::default(),
-        probes: vec![],
-        pressure_sensors: vec![],
-        bodies: vec![],
-        wave_maker: None,
-        obstacles: vec![],
-    }
+    let tank = TankSpec {
+        length,
+        breadth: 0.25,
+        height,
+    };
+    SimParams::filled_tank(2, tank, fill, dp)
 }
 
 /// A probe at abscissa x on the centre line.
