@@ -77,6 +77,15 @@ pub fn first_oversized_chunk(bytes: &[u8]) -> Option<Oversized> {
     None
 }
 
+/// The part of the file the reader may be given: all of it, or what precedes the first oversized chunk
+/// (returned beside it).
+pub fn readable(bytes: &[u8]) -> (&[u8], Option<Oversized>) {
+    match first_oversized_chunk(bytes) {
+        Some(o) => (&bytes[..o.offset], Some(o)),
+        None => (bytes, None),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -138,13 +147,13 @@ mod tests {
         assert!(o.claimed > 1 << 56, "{o:?}");
         assert!(o.to_string().contains(&format!("byte {second}")), "{o}");
         // What lies before it reads whole.
-        let before = mcap::MessageStream::new_with_options(
-            &b[..o.offset],
-            mcap::read::Options::IgnoreEndMagic.into(),
-        )
-        .unwrap()
-        .take_while(|m| m.is_ok())
-        .count();
+        let (part, again) = readable(&b);
+        assert_eq!(again, Some(o));
+        let before =
+            mcap::MessageStream::new_with_options(part, mcap::read::Options::IgnoreEndMagic.into())
+                .unwrap()
+                .take_while(|m| m.is_ok())
+                .count();
         assert!(before > 0 && before < 50, "{before}");
     }
 }

@@ -502,8 +502,7 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
         let bytes =
             unsafe { memmap2::Mmap::map(&f) }.map_err(|e| bad(file, format!("cannot map: {e}")))?;
         // A chunk claiming an impossible size ends what is recovered (the reader would try to allocate it).
-        let oversized = crate::mcap_bounds::first_oversized_chunk(&bytes);
-        let readable = oversized.map_or(&bytes[..], |o| &bytes[..o.offset]);
+        let (readable, oversized) = crate::mcap_bounds::readable(&bytes);
         let stream = mcap::MessageStream::new_with_options(
             readable,
             mcap::read::Options::IgnoreEndMagic.into(),
@@ -574,8 +573,7 @@ fn surviving_parameters(file: &Path) -> Option<BTreeMap<String, String>> {
     let f = std::fs::File::open(file).ok()?;
     // SAFETY: only read while this function runs (as in `repair`).
     let bytes = unsafe { memmap2::Mmap::map(&f) }.ok()?;
-    let readable = crate::mcap_bounds::first_oversized_chunk(&bytes)
-        .map_or(&bytes[..], |o| &bytes[..o.offset]);
+    let (readable, _) = crate::mcap_bounds::readable(&bytes);
     let reader = mcap::read::LinearReader::new_with_options(
         readable,
         mcap::read::Options::IgnoreEndMagic.into(),

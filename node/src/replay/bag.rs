@@ -122,8 +122,7 @@ pub fn for_each_message(
             ));
         }
         // A chunk claiming an impossible size ends what is read (the reader would try to allocate it).
-        let oversized = crate::mcap_bounds::first_oversized_chunk(&map);
-        let readable = oversized.map_or(&map[..], |o| &map[..o.offset]);
+        let (readable, oversized) = crate::mcap_bounds::readable(&map);
         let options = if oversized.is_some() {
             mcap::read::Options::IgnoreEndMagic.into()
         } else {

@@ -135,13 +135,13 @@ pub fn free_decay(
     })
 }
 
-/// Advances to `t_end`, sampling `what` every [`SAMPLE`] s.
-fn record(
+/// Advances to `t_end`, sampling `what` every [`SAMPLE`] s: the sample times and values.
+fn record<T>(
     sim: &mut dyn Solver,
     motion: &dyn TankMotion,
     t_end: f64,
-    what: impl Fn(&crate::observe::Observation) -> f64,
-) -> Result<(Vec<f64>, Vec<f64>), ExperimentError> {
+    what: impl Fn(&crate::observe::Observation) -> T,
+) -> Result<(Vec<f64>, Vec<T>), ExperimentError> {
     let (mut times, mut values) = (vec![], vec![]);
     let n = (t_end / SAMPLE).round() as usize;
     for i in 1..=n {
@@ -302,31 +302,29 @@ pub fn tilted(
     let mut sim = crate::build(params)?;
     let from = ramp + settle;
     let to = from + periods * tank.natural_period(1);
-    let n_probes = sim.params().probes.len();
-    let (mut force, mut moment, mut probes, mut n) = ([0.0; 3], 0.0, vec![0.0; n_probes], 0.0);
-    let steps = (to / SAMPLE).round() as usize;
-    for i in 1..=steps {
-        let t = i as f64 * SAMPLE;
-        sim.advance_to(&motion, t)?;
-        if t < from {
-            continue;
-        }
-        let o = sim.observe(&motion)?;
-        for k in 0..3 {
-            force[k] += o.wrench.force[k];
-        }
-        moment += o.wrench.moment[1];
-        for (p, v) in probes.iter_mut().zip(&o.probes) {
-            *p += v;
-        }
-        n += 1.0;
-    }
+    let (times, rows) = record(sim.as_mut(), &motion, to, |o| {
+        (o.wrench.force, o.wrench.moment[1], o.probes.clone())
+    })?;
+    // The samples held at the tilt, averaged.
+    type Row = ([f64; 3], f64, Vec<f64>);
+    let held: Vec<&Row> = times
+        .iter()
+        .zip(&rows)
+        .filter(|(&t, _)| t >= from)
+        .map(|(_, r)| r)
+        .collect();
+    let mean = |f: &dyn Fn(&Row) -> f64| held.iter().map(|r| f(r)).sum::<f64>() / held.len() as f64;
+    let force = std::array::from_fn(|k| mean(&|r| r.0[k]));
+    let moment = mean(&|r| r.1);
+    let probes = (0..sim.params().probes.len())
+        .map(|i| mean(&|r| r.2[i]))
+        .collect();
     Ok(Tilted {
         theta,
-        force: force.map(|f| f / n),
-        moment: moment / n,
+        force,
+        moment,
         theory_moment: tank.tilted_moment(theta),
         weight: tank.liquid_mass() * tank.gravity,
-        probes: probes.into_iter().map(|p| p / n).collect(),
+        probes,
     })
 }

@@ -46,32 +46,25 @@ pub fn free_decay(t: &[f64], y: &[f64], period_guess: f64) -> Result<Decay, Sign
     }
     let t0 = t[0];
     let w0 = 2.0 * PI / period_guess;
-    // Residual and coefficients of the linear fit at (ω, σ).
+    // Residual and coefficients of the linear fit at (ω, σ) (an infinite residual where it is singular).
     let fit = |w: f64, s: f64| -> (f64, [f64; 3]) {
-        let mut a = [[0.0f64; 4]; 3];
-        for (&ti, &yi) in t.iter().zip(y) {
+        let basis = |ti: f64, j: usize| {
             let tt = ti - t0;
-            let e = (-s * tt).exp();
-            let b = [e * (w * tt).cos(), e * (w * tt).sin(), 1.0];
-            for r in 0..3 {
-                for c in 0..3 {
-                    a[r][c] += b[r] * b[c];
-                }
-                a[r][3] += b[r] * yi;
+            match j {
+                0 => (-s * tt).exp() * (w * tt).cos(),
+                1 => (-s * tt).exp() * (w * tt).sin(),
+                _ => 1.0,
             }
-        }
-        let x = solve3(a);
+        };
+        let Some(x) = least_squares(t, y, 3, basis) else {
+            return (f64::INFINITY, [0.0; 3]);
+        };
         let res: f64 = t
             .iter()
             .zip(y)
-            .map(|(&ti, &yi)| {
-                let tt = ti - t0;
-                let e = (-s * tt).exp();
-                let m = e * (x[0] * (w * tt).cos() + x[1] * (w * tt).sin()) + x[2];
-                (yi - m).powi(2)
-            })
+            .map(|(&ti, &yi)| (yi - (0..3).map(|j| x[j] * basis(ti, j)).sum::<f64>()).powi(2))
             .sum();
-        (res, x)
+        (res, [x[0], x[1], x[2]])
     };
     // Grid: ω within ±20 % of the guess, σ from −0.05 ω to 0.3 ω.
     let (mut best, mut bw, mut bs) = (f64::INFINITY, w0, 0.0);
@@ -112,27 +105,40 @@ pub fn free_decay(t: &[f64], y: &[f64], period_guess: f64) -> Result<Decay, Sign
     })
 }
 
-/// Solves the 3×3 system held as an augmented matrix (partial pivoting).
-fn solve3(mut a: [[f64; 4]; 3]) -> [f64; 3] {
-    for col in 0..3 {
-        let p = (col..3)
-            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
-            .unwrap();
-        a.swap(col, p);
-        let d = a[col][col];
-        if d == 0.0 {
-            return [0.0; 3];
+/// Least-squares coefficients of `m` basis functions (`basis(t, j)`, j < m) fitted to the samples, by the
+/// normal equations and Gaussian elimination with partial pivoting; `None` where they are singular.
+fn least_squares(
+    t: &[f64],
+    y: &[f64],
+    m: usize,
+    basis: impl Fn(f64, usize) -> f64,
+) -> Option<Vec<f64>> {
+    let mut a = vec![vec![0.0; m + 1]; m];
+    for (&ti, &yi) in t.iter().zip(y) {
+        let b: Vec<f64> = (0..m).map(|j| basis(ti, j)).collect();
+        for r in 0..m {
+            for c in 0..m {
+                a[r][c] += b[r] * b[c];
+            }
+            a[r][m] += b[r] * yi;
         }
-        for r in 0..3 {
+    }
+    for col in 0..m {
+        let p = (col..m).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        a.swap(col, p);
+        if a[col][col].abs() < 1e-12 {
+            return None;
+        }
+        for r in 0..m {
             if r != col {
-                let f = a[r][col] / d;
-                for c in col..4 {
+                let f = a[r][col] / a[col][col];
+                for c in col..=m {
                     a[r][c] -= f * a[col][c];
                 }
             }
         }
     }
-    [a[0][3] / a[0][0], a[1][3] / a[1][1], a[2][3] / a[2][2]]
+    Some((0..m).map(|r| a[r][m] / a[r][r]).collect())
 }
 
 /// Amplitude and phase of `y` at `w` (rad/s): y ≈ amplitude · sin(w t + phase) + (sines at `others`) + a
@@ -157,37 +163,10 @@ pub fn harmonic(t: &[f64], y: &[f64], w: f64, others: &[f64]) -> Result<(f64, f6
             }
         }
     };
-    // Normal equations, solved by Gaussian elimination with partial pivoting.
-    let mut a = vec![vec![0.0; m + 1]; m];
-    for (&ti, &yi) in t.iter().zip(y) {
-        let b: Vec<f64> = (0..m).map(|j| basis(ti, j)).collect();
-        for r in 0..m {
-            for c in 0..m {
-                a[r][c] += b[r] * b[c];
-            }
-            a[r][m] += b[r] * yi;
-        }
-    }
-    for col in 0..m {
-        let p = (col..m)
-            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
-            .unwrap();
-        a.swap(col, p);
-        if a[col][col].abs() < 1e-12 {
-            return Err(SignalError(
-                "the frequencies cannot be told apart over this record".into(),
-            ));
-        }
-        for r in 0..m {
-            if r != col {
-                let f = a[r][col] / a[col][col];
-                for c in col..=m {
-                    a[r][c] -= f * a[col][c];
-                }
-            }
-        }
-    }
-    let (s, c) = (a[1][m] / a[1][1], a[2][m] / a[2][2]);
+    let x = least_squares(t, y, m, basis).ok_or_else(|| {
+        SignalError("the frequencies cannot be told apart over this record".into())
+    })?;
+    let (s, c) = (x[1], x[2]);
     // s sin + c cos = R sin(wt + φ), R = hypot, φ = atan2(c, s).
     Ok((s.hypot(c), c.atan2(s)))
 }
