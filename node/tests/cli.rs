@@ -574,3 +574,94 @@ fn is_root() -> bool {
         .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
         .unwrap_or(false)
 }
+
+/// The README's commands as a reader copies them: the quick start's run (at a short duration), the minimal
+/// config, and every command of its commands table (`--help`), so a renamed flag or command fails here.
+#[test]
+fn the_readme_s_commands_run() {
+    let readme = std::fs::read_to_string("../README.md").unwrap();
+    let out = tmp("readme");
+    // The quick start's run.
+    let quick = readme
+        .lines()
+        .find_map(|l| {
+            l.trim()
+                .strip_prefix("cargo run --release --bin slosh -- run ")
+        })
+        .expect("the README's quick start runs a case");
+    let mut args: Vec<String> = quick.split_whitespace().map(str::to_string).collect();
+    for (flag, value) in [
+        ("--duration", "0.1".to_string()),
+        ("--out", out.join("quick").display().to_string()),
+    ] {
+        let i = args
+            .iter()
+            .position(|a| a == flag)
+            .unwrap_or_else(|| panic!("the quick start has no {flag}"));
+        args[i + 1] = value;
+    }
+    let st = slosh()
+        .arg("run")
+        .args(&args)
+        .current_dir("..")
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{quick}: {}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    for f in ["probes.csv", "wrench.csv", "pressure.csv", "summary.json"] {
+        assert!(out.join("quick").join(f).exists(), "{quick}: no {f}");
+    }
+    // The minimal config.
+    let section = &readme[readme
+        .find("## A minimal config")
+        .expect("a minimal config section")..];
+    let yaml = section
+        .split("```yaml\n")
+        .nth(1)
+        .and_then(|s| s.split("```").next())
+        .expect("a yaml block in the minimal config section");
+    std::fs::create_dir_all(&out).unwrap();
+    let case = out.join("minimal.yaml");
+    std::fs::write(&case, yaml).unwrap();
+    let st = slosh()
+        .arg("run")
+        .arg(&case)
+        .arg("--out")
+        .arg(out.join("minimal"))
+        .args(["--duration", "0.1", "--set", "solver.kernel=wendland"])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "the minimal config: {}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let (h, rows) = csv(&out.join("minimal/probes.csv"));
+    assert_eq!(h, ["time", "wall", "mid"]);
+    assert!(rows.iter().all(|r| (r[2] - 0.19).abs() < 0.02), "{rows:?}");
+    // Every command of the table.
+    let mut commands = 0;
+    for row in readme.lines().filter(|l| l.starts_with("| `slosh ")) {
+        let words: Vec<&str> = row["| `slosh ".len()..]
+            .split(['`', ' '])
+            .take_while(|w| {
+                !w.is_empty()
+                    && !w.starts_with('-')
+                    && w.chars().all(|c| c.is_ascii_lowercase() || c == '-')
+            })
+            .collect();
+        let st = slosh().args(&words).arg("--help").output().unwrap();
+        assert!(
+            st.status.success(),
+            "`slosh {}` from the README: {}",
+            words.join(" "),
+            String::from_utf8_lossy(&st.stderr)
+        );
+        commands += 1;
+    }
+    assert!(commands >= 10, "{commands} commands in the README's table");
+    let _ = std::fs::remove_dir_all(&out);
+}
