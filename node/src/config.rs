@@ -534,7 +534,7 @@ fn plain_type_error(message: &str, key: &str) -> String {
     if let Some((head, _)) = message.split_once(", expected struct ") {
         let got = head.strip_prefix("invalid type: ").unwrap_or(head);
         return format!(
-            "a group of parameters, not one value (got {got}): set its members by name (`{key}.MEMBER`, e.g. with -p {key}.MEMBER:=VALUE, or nested under `{key}` in the file; see the README's parameter tables)"
+            "a group of parameters, not one value (got {got}): set its members by name (`{key}.MEMBER`, e.g. with -p {key}.MEMBER:=VALUE, or nested under `{key}` in the file; see the parameter reference, docs/src/guide/parameters.md)"
         );
     }
     for (rust, plain) in [

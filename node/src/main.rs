@@ -312,7 +312,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     // same outputs.
     #[cfg(not(feature = "mpi"))]
     if let Some(n) = slosh_node::memory::mpi_world_size().filter(|n| *n > 1) {
-        anyhow::bail!("started as one of {n} MPI ranks, but this slosh was built without MPI: build it with `cargo build --release -p slosh-node --features mpi` (see the README's MPI section), or run it without mpirun");
+        anyhow::bail!("started as one of {n} MPI ranks, but this slosh was built without MPI: build it with `cargo build --release -p slosh-node --features mpi` (see the manual's MPI page, docs/src/guide/mpi.md), or run it without mpirun");
     }
     // Under mpirun every rank runs this binary: rank 0 goes on with the command (its simulations spread
     // over all ranks), the others follow its solver calls until it is done.

@@ -10,7 +10,7 @@
 //!   32-byte points).
 //!
 //! DDS sends discovery traffic: run it inside a loopback-only network namespace (`unshare -rn`, see the
-//! README) unless the machine's network may see it.
+//! manual's iceoryx2 page) unless the machine's network may see it.
 
 use crate::iox::client::CouplingClient;
 use crate::iox::{self, Particle, ParticleHeader, StepOutputs};
@@ -364,7 +364,7 @@ fn matched(node: &ros2_client::Node, out: &str, back: &str) -> anyhow::Result<()
     {
         anyhow::ensure!(
             Instant::now() < end,
-            "DDS discovery did not match /slosh_bench/{out} and /{back} within 30 s (is multicast on loopback routed? see the README)"
+            "DDS discovery did not match /slosh_bench/{out} and /{back} within 30 s (is multicast on loopback routed? see docs/src/guide/iceoryx2.md)"
         );
         std::thread::sleep(Duration::from_millis(10));
     }

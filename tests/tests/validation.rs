@@ -198,7 +198,7 @@ fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str) {
     assert!(lin_err < 0.15, "differs from linear theory by {lin_err}");
 
     // 2. Experiment (0-7 s): the crests and troughs come at the measured times (correlation), and the
-    //    elevation has the measured size within the bound documented in the README: the simulation is about
+    //    elevation has the measured size within the bound documented in the manual's validation page: the simulation is about
     //    1.3x the record, mostly from its larger crests after 2 s (0.196 m against 0.157 m in linear theory and
     //    0.142 m measured; the figure this test draws shows all three).
     let pts: Vec<&Vec<f64>> = exp.iter().filter(|r| r[0] <= t_end).collect();

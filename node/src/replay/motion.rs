@@ -171,7 +171,7 @@ fn choose<'f>(
 ) -> Result<(&'f str, &'f Found), BagError> {
     let types = "nav_msgs/msg/Odometry, geometry_msgs/msg/PoseStamped or sensor_msgs/msg/Imu";
     if let Some(t) = topic {
-        // The bag's name, or a relative one (`motion/odom`, as ROS 2 users and the README's topic table
+        // The bag's name, or a relative one (`motion/odom`, as ROS 2 users and the manual's topic table
         // write it) resolved against the root namespace, as the bag's names are.
         let Some((name, f)) = found
             .get_key_value(t)
