@@ -127,7 +127,7 @@ pub struct Recorder {
     start_ns: Option<u64>,
     end_ns: u64,
     sequence: u32,
-    /// Added to every log time given (see [`Recorder::shift_log_times`]).
+    /// Added to every log time given (see [`Recorder::continue_from`]).
     shift_ns: i64,
     /// `flush_interval_s` in ns (0: off), and the log time of the last chunk written out.
     flush_ns: u64,
@@ -248,7 +248,7 @@ impl Recorder {
         write_error(&self.dir, e)
     }
 
-    /// Records `msg` on `topic` at `log_time` (ROS time, shifted as [`Recorder::shift_log_times`] says;
+    /// Records `msg` on `topic` at `log_time` (ROS time, shifted as [`Recorder::continue_from`] says;
     /// negative times are written as 0).
     pub fn write<M: RosMessage>(
         &mut self,
@@ -260,7 +260,7 @@ impl Recorder {
         self.write_message(&raw, log_time)
     }
 
-    /// Records a serialized message at `log_time` (shifted as [`Recorder::shift_log_times`] says).
+    /// Records a serialized message at `log_time` (shifted as [`Recorder::continue_from`] says).
     pub fn write_message(&mut self, m: &RawMessage, log_time: Time) -> Result<(), RecordError> {
         let ns = log_time.as_nanos().saturating_add(self.shift_ns).max(0) as u64;
         self.write_raw(&m.topic, &m.type_name, &m.schema, ns, &m.data)

@@ -3,7 +3,7 @@
 //! `density`, `fluid` (1 liquid, 0 boundary) and `id`; the simulation time as the field `TimeValue`.
 //! Arrays are inline base64 ("binary" format) with a UInt64 byte-count header, little endian.
 //!
-//! [`read`] reads back the files [`write`] makes (for `slosh render`); it is not a general VTK reader.
+//! [`read`] reads back the files [`write()`] makes (for `slosh render`); it is not a general VTK reader.
 
 use base64::engine::general_purpose::STANDARD as B64;
 use base64::Engine;
@@ -139,7 +139,7 @@ fn data_array(text: &str, name: &str) -> Result<Vec<u8>, String> {
     Ok(bytes)
 }
 
-/// Reads a frame written by [`write`].
+/// Reads a frame written by [`write()`].
 pub fn read(path: &Path) -> Result<Snapshot, ReadError> {
     let err = |message: String| ReadError {
         path: path.display().to_string(),

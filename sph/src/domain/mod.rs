@@ -18,7 +18,7 @@
 //!
 //! Every rank runs the same calls: rank 0 drives a [`Distributed`] solver that broadcasts each call (and the
 //! tank motion, step by step) to the other ranks, which [`serve`] until rank 0 stops them. The transport is
-//! the small [`Comm`] trait; [`mpi`] implements it with MPI (cargo feature `mpi`).
+//! the small [`Comm`] trait; `mpi` implements it with MPI (cargo feature `mpi`).
 
 mod exchange;
 #[cfg(feature = "mpi")]

@@ -8,7 +8,7 @@
 //! squared distances too, instead of v_b·(x_a − x_b), was no faster than the copy.)
 //!
 //! On x86_64 with AVX2 each block of eight candidates is packed with one permutation per array (the
-//! selected lanes to the front, [`PACK`]) and one 32-byte store; elsewhere lane by lane. Both compute the
+//! selected lanes to the front, `PACK`) and one 32-byte store; elsewhere lane by lane. Both compute the
 //! offsets, squared lengths and velocities along the offsets with the same operations in the same order (no
 //! fused multiply-add), so they select the same neighbours and store the same values to the bit.
 

@@ -3,7 +3,7 @@
 //! records a list holds ([`Grad`]).
 //!
 //! [`pair_sum`] is the generic loop. In 3D the lists hold each gradient in half precision
-//! ([`Half4`](super::half::Half4), 8 bytes a pair: the lists outgrow the L2 caches and the passes wait on
+//! ([`Half4`], 8 bytes a pair: the lists outgrow the L2 caches and the passes wait on
 //! memory) and the solver each velocity in four lanes; on x86_64 with AVX2 and F16C the sums convert
 //! two pairs' gradients with one instruction and run two pairs per 256-bit register, one load per
 //! neighbour's velocity; the results are the same to the bit as [`pair_sum`]'s over the converted
