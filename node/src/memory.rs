@@ -7,7 +7,7 @@ use sph::params::{Scheme, SimParams};
 /// Bytes a particle needs at least (measured with `slosh run`'s peak resident memory, less the ~8 MB of a
 /// run of a few particles: the 3D seed tank at dp 10 mm, 78,000 liquid and 55,956 wall particles, took 48 MB
 /// with `wcsph` and 134 MB with `dfsph`, whose neighbour lists hold ~80 neighbours' gradients per liquid
-/// particle in 3D (184 MB until the gradients were stored in half precision, 2026-12-02); the 2D tank at
+/// particle in 3D (184 MB with the gradients in single precision); the 2D tank at
 /// dp 2 mm, 78,000 and 4,236, 25 and 52 MB): kept below the measured figures, so that a refused case would
 /// not have fitted.
 fn bytes_per_particle(p: &SimParams) -> (f64, f64) {

@@ -67,7 +67,7 @@ fn facts(run: &Path) -> Facts {
     let s: Option<serde_json::Value> = std::fs::read_to_string(run.join("summary.json"))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
-    // (`effective_parameters` since 2026-12-02; earlier runs' summaries have the given ones only)
+    // (summaries written by older versions have the given parameters only)
     let p = s.as_ref().map(|s| match &s["effective_parameters"] {
         serde_json::Value::Null => &s["parameters"],
         e => e,

@@ -165,9 +165,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         });
         let (g, top) = (params.gravity, params.fill.height);
         // (A liquid block against the −x wall: walls beyond its end start without pressure. A tank filled
-        // end to end: every wall layer, the +x wall's outer ones too, starts hydrostatic; until 2026-12-02
-        // those beyond its face started at ρ0, and the liquid's first force on the tank leaned 1.3 % of
-        // its weight towards −x.)
+        // end to end: every wall layer, the +x wall's outer ones too, starts hydrostatic; were those beyond
+        // its face to start at ρ0, the liquid's first force on the tank would lean 1.3 % of its weight
+        // towards −x.)
         let fill_x1 = if params.fill_length() < params.tank.length {
             tank.lo[0] + params.fill_length()
         } else {

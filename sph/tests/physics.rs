@@ -65,8 +65,8 @@ fn check_hydrostatics_within(p: SimParams, t_end: f64, probe_tol: f64, sensor_to
     if p.solver.scheme == Scheme::Wcsph {
         // The weakly-compressible scheme starts hydrostatic, walls included: its first force is about the
         // weight (within 3 %: the mirror boundary and the 3D Wendland case read 2.9 % high and 2.8 % low
-        // before the first step), straight down (the +x wall's outer layers started without pressure
-        // until 2026-12-02: fx was 1.3 % of the weight).
+        // before the first step), straight down (with the +x wall's outer layers started without pressure,
+        // fx was 1.3 % of the weight).
         let f = sim.observe(&AtRest).unwrap().wrench.force;
         assert!(
             (f[2] + weight).abs() < 0.03 * weight,
@@ -836,8 +836,8 @@ fn dfsph_iteration_control_keeps_every_step_converged() {
 #[test]
 fn steps_land_on_the_requested_times_without_slivers() {
     // Outputs every 7 ms, not a multiple of either scheme's step: the step before each lands on it, none
-    // shorter than half a step (until 2026-12-02 WCSPH cut the step that passed it, and left steps of
-    // 1e-7 s), and the time is exactly the one asked for.
+    // shorter than half a step (cutting the step that passes it leaves steps of 1e-7 s), and the time is
+    // exactly the one asked for.
     for scheme in [Scheme::Wcsph, Scheme::Dfsph] {
         let mut p = tank2d(0.8, 0.6, 0.39, 0.04);
         p.solver.scheme = scheme;

@@ -1,6 +1,7 @@
-//! The manual (`docs/`, an mdBook) and the README hold together: every page is listed in the summary and every
-//! listed page exists, and every relative link resolves to a file, and every `#anchor` to a heading of the
-//! page it names (as mdBook and GitHub derive heading ids). External links are not followed.
+//! The manual (`docs/`, an mdBook), the README, the changelog and ARCHITECTURE.md hold together: every page
+//! is listed in the summary and every listed page exists, every relative link resolves to a file and every
+//! `#anchor` to a heading of the page it names (as mdBook and GitHub derive heading ids), and the tables
+//! made from data are the ones their data make. External links are not followed.
 
 use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
@@ -136,6 +137,7 @@ fn the_manual_and_the_readme_link_only_to_what_exists() {
     pages(&src, &mut all);
     all.push(root().join("README.md"));
     all.push(root().join("CHANGELOG.md"));
+    all.push(root().join("ARCHITECTURE.md"));
     let mut texts = HashMap::new();
     let bad: Vec<String> = all.iter().flat_map(|p| broken(p, &mut texts)).collect();
     assert!(bad.is_empty(), "broken links:\n{}", bad.join("\n"));

@@ -35,7 +35,7 @@ fn figure(name: &str, title: &str, y_label: &str, series: Vec<Series>) -> Vec<Pa
             title: String::new(),
             y_label: y_label.to_string(),
             series,
-            level: None,
+            ..Default::default()
         }],
     )
 }
@@ -449,7 +449,7 @@ fn akyildiz_2006(overrides: &[&str], t_end: f64, name: &str, label: &str, corr8:
                 series(&format!("slosh ({label}), 0.1 s mean"), t, p, false),
                 series("measured (Akyildiz & Unal 2006, fig. 5)", te, pe, true),
             ],
-            level: None,
+            ..Default::default()
         })
         .collect();
     figure_panels(
@@ -638,7 +638,7 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
                 series("slosh (DFSPH, dp 40 mm)", &t, &hs, false),
                 series("measured (MARIN, SPHERIC Test 2)", &te, &he, true),
             ],
-            level: None,
+            ..Default::default()
         });
         let tol = if k == 2 { 0.15 } else { 0.05 };
         checks.push((name.to_string(), corr, ratio, a_sim - a_exp, tol));
@@ -690,7 +690,7 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
                 series("slosh (DFSPH, dp 40 mm)", &t, &ps, false),
                 series("measured (MARIN, SPHERIC Test 2)", &te, &pe, true),
             ],
-            level: None,
+            ..Default::default()
         });
         checks.push((name, corr, ms / me, ws - we));
     }

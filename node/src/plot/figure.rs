@@ -25,6 +25,10 @@ pub struct Panel {
     pub series: Vec<Series>,
     /// A level marked across the panel, with its legend text.
     pub level: Option<(f64, String)>,
+    /// The x axis's quantity and unit (empty: time, "t (s)").
+    pub x_label: String,
+    /// Mark every point of the run's series (for a few points, e.g. one per particle spacing).
+    pub markers: bool,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -37,6 +41,15 @@ pub struct Figure {
 
 const FONT: &str = "sans-serif";
 const RUN: RGBColor = RGBColor(0, 114, 178);
+/// The colours of a panel's run series, in order (the first is [`RUN`]; Okabe & Ito's palette).
+const RUNS: [RGBColor; 6] = [
+    RUN,
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+    RGBColor(117, 112, 179),
+    RGBColor(153, 153, 153),
+];
 const REFERENCES: [RGBColor; 3] = [
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),
@@ -119,7 +132,11 @@ where
         .map_err(e)?;
     chart
         .configure_mesh()
-        .x_desc("t (s)")
+        .x_desc(if p.x_label.is_empty() {
+            "t (s)"
+        } else {
+            p.x_label.as_str()
+        })
         .y_desc(p.y_label.as_str())
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))
@@ -140,16 +157,22 @@ where
             .label(text.as_str())
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
     }
-    let mut k_ref = 0;
+    let (mut k_ref, mut k_run) = (0, 0);
     for s in &p.series {
         let colour = if s.reference {
             k_ref += 1;
             REFERENCES[(k_ref - 1) % REFERENCES.len()]
         } else {
-            RUN
+            k_run += 1;
+            RUNS[(k_run - 1) % RUNS.len()]
         };
         let style = colour.stroke_width(2);
         for (i, seg) in segments(s).into_iter().enumerate() {
+            if p.markers && !s.reference && seg.len() > 1 {
+                chart
+                    .draw_series(seg.iter().map(|&xy| Circle::new(xy, 3, colour.filled())))
+                    .map_err(e)?;
+            }
             // A value between two gaps (NaN) has no line to be part of: a dot.
             let drawn = if seg.len() == 1 {
                 chart.draw_series(std::iter::once(Circle::new(seg[0], 3, colour.filled())))

@@ -130,7 +130,7 @@ pub fn plot(dir: &Path, opts: &PlotOptions) -> Result<Plotted, String> {
             title,
             y_label: y_label.to_string(),
             series,
-            level: None,
+            ..Default::default()
         }
     };
 

@@ -1,8 +1,8 @@
 //! Landing a step on a given time (an output time, the end of the motion) without leaving a sliver of a
 //! step for after: a step much shorter than the flow's is wasted work at best, and in the incompressible
 //! scheme it corrects the density error it starts with within that sliver and flings particles. Both
-//! schemes land this way (the weakly-compressible one since 2026-12-02: before, it cut the step that would
-//! pass the time, and left steps of 1e-7 s, which `min_dt_s` reported).
+//! schemes land this way (cutting the step that would pass the time instead leaves steps of 1e-7 s, which
+//! `min_dt_s` would report).
 
 /// The step to take when the flow allows `dt` and a time to land on is `room` ahead: `room` itself when
 /// it is within one step, half of it when within two (so no sliver is left for the step after), else `dt`.

@@ -18,9 +18,9 @@
 //!
 //! Every start of a k ≥ 0 (the solve's are) lies between REST times the last k and the last k, so no particle
 //! starts above what it had. The carried part is a smooth field (the column's depth, scaled per column), so
-//! the particle-to-particle noise is still cut every step (to 0.6 of it; the plain warm start halves it, and
-//! until 2026-12-02 so did this one: 0.6 takes 12 % fewer iterations on the 3D seed benchmark with the same
-//! answer and a tank at rest as still, where 0.7 stirs a 3D tank at rest at 1.5 ms steps); β < 1 leaves a
+//! the particle-to-particle noise is still cut every step (to 0.6 of it; the plain warm start halves it: 0.6
+//! takes 12 % fewer iterations than 0.5 on the 3D seed benchmark with the same answer and a tank at rest as
+//! still, where 0.7 stirs a 3D tank at rest at 1.5 ms steps); β < 1 leaves a
 //! little hydrostatic pressure to rebuild every step, and R (the column's pressure relative to hydrostatic)
 //! makes a column whose pressure falls below hydrostatic (a collapsing dam-break column, free fall) start from
 //! its own, lower level, so that its pressure can keep falling, by (1 − β)(1 − REST) = 2 % a step at least:

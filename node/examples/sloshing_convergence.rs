@@ -1,0 +1,335 @@
+//! The seed tank's first sloshing mode as the solver gives it, against linear theory, by scheme setting,
+//! dimension, fill and particle spacing: the free-decay period error and damping ratio beside the laminar
+//! boundary-layer value (`sph::sloshing`). Writes what the manual shows:
+//!
+//! - the table between the `convergence` markers of `docs/src/validation/sloshing.md`,
+//! - `docs/src/validation/convergence.csv`, the same rows as data,
+//! - `docs/src/images/convergence.svg`, period error and damping ratio against the spacing.
+//!
+//! ```text
+//! cargo run --release -p slosh-node --example sloshing_convergence              # about an hour on 2 cores
+//! cargo run --release -p slosh-node --example sloshing_convergence -- --fine    # adds 3D at 10 mm, 2D wcsph at 5 mm
+//! cargo run --release -p slosh-node --example sloshing_convergence -- --quick   # 2D at 40 and 20 mm, printed only
+//! cargo run --release -p slosh-node --example sloshing_convergence -- --redraw  # table and figure from the CSV
+//! ```
+//!
+//! `--png FILE` also draws the figure as a PNG (to look at without an SVG viewer).
+use plotters::prelude::*;
+use slosh_node::plot::figure::{self, Figure, Panel, Series};
+use sph::kernel::KernelKind;
+use sph::params::{Scheme, SimParams};
+use sph::sloshing::experiment::{free_decay, seed_tank};
+use std::fmt::Write;
+use std::path::Path;
+
+/// A scheme setting: its name in the table and what it changes from `seed_tank`'s defaults.
+struct Setting {
+    name: &'static str,
+    apply: fn(&mut SimParams),
+}
+
+const SETTINGS: [Setting; 3] = [
+    Setting {
+        name: "dfsph (shipped)",
+        apply: |p| p.solver.scheme = Scheme::Dfsph,
+    },
+    Setting {
+        name: "dfsph + kernel_correction, wendland, α 0",
+        apply: |p| {
+            p.solver.scheme = Scheme::Dfsph;
+            p.solver.kernel = KernelKind::Wendland;
+            p.solver.dfsph.kernel_correction = true;
+            p.solver.artificial_viscosity.alpha = 0.0;
+        },
+    },
+    Setting {
+        name: "wcsph (shipped)",
+        apply: |p| p.solver.scheme = Scheme::Wcsph,
+    },
+];
+
+const FILLS: [f64; 2] = [0.19, 0.39];
+
+/// One free decay.
+struct Row {
+    setting: String,
+    dim: usize,
+    fill: f64,
+    dp: f64,
+    /// Period, theory period, damping ratio, laminar damping ratio, wall seconds; or why it failed.
+    result: Result<[f64; 5], String>,
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let fine = args.iter().any(|a| a == "--fine");
+    let png = args
+        .iter()
+        .position(|a| a == "--png")
+        .map(|i| args.get(i + 1).expect("--png FILE").clone());
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let data = root.join("docs/src/validation/convergence.csv");
+    if args.iter().any(|a| a == "--redraw") {
+        let text = std::fs::read_to_string(&data).expect("docs/src/validation/convergence.csv");
+        let (rows, heading) = read_csv(&text);
+        write(&root, &rows, &heading, png);
+        return;
+    }
+    let mut rows = Vec::new();
+    for (si, s) in SETTINGS.iter().enumerate() {
+        let wcsph = si == 2;
+        let mut cases: Vec<(usize, f64)> = vec![(2, 0.04), (2, 0.02)];
+        if !quick {
+            cases.extend([(2, 0.01), (2, 0.008)]);
+            // WCSPH's steps follow the speed of sound: its 2D 5 mm decays take ten minutes each, its 3D ones
+            // hours.
+            if !wcsph || fine {
+                cases.push((2, 0.005));
+            }
+            if !wcsph {
+                cases.extend([(3, 0.04), (3, 0.02)]);
+                if fine {
+                    cases.push((3, 0.01));
+                }
+            }
+        }
+        for &(dim, dp) in &cases {
+            for fill in FILLS {
+                let mut p = seed_tank(dim, fill, dp);
+                (s.apply)(&mut p);
+                let result = free_decay(p, 0.01, 8.0)
+                    .map(|r| {
+                        [
+                            r.decay.period,
+                            r.theory_period,
+                            r.decay.damping_ratio,
+                            r.laminar.ratio,
+                            r.wall_time,
+                        ]
+                    })
+                    .map_err(|e| e.to_string());
+                let row = Row {
+                    setting: s.name.to_string(),
+                    dim,
+                    fill,
+                    dp,
+                    result,
+                };
+                println!("{}", table_row(&row));
+                rows.push(row);
+            }
+        }
+    }
+    if quick {
+        return;
+    }
+    let machine = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|c| {
+            c.lines().find_map(|l| {
+                l.strip_prefix("model name")
+                    .map(|m| m.trim_start_matches([' ', '\t', ':']).to_string())
+            })
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let threads = rayon::current_num_threads();
+    let heading = format!("{machine} ({threads} threads)");
+    let mut csv = format!("# {heading}\n{CSV_HEADER}\n");
+    for r in &rows {
+        match &r.result {
+            Ok([t, t0, z, zl, w]) => writeln!(
+                csv,
+                "\"{}\",{},{},{},{t:.6},{t0:.6},{:.6},{z:.6},{zl:.6},{w:.1},",
+                r.setting,
+                r.dim,
+                r.fill,
+                r.dp,
+                t / t0 - 1.0
+            ),
+            Err(e) => writeln!(
+                csv,
+                "\"{}\",{},{},{},,,,,,,\"{}\"",
+                r.setting,
+                r.dim,
+                r.fill,
+                r.dp,
+                e.replace('"', "'")
+            ),
+        }
+        .unwrap();
+    }
+    std::fs::write(&data, csv).unwrap();
+    write(&root, &rows, &heading, png);
+}
+
+const CSV_HEADER: &str = "setting,dimension,fill_m,dp_m,period_s,theory_period_s,period_error,damping_ratio,laminar_damping_ratio,wall_s,error";
+
+/// The rows of the CSV this command writes, and its first line's machine.
+fn read_csv(text: &str) -> (Vec<Row>, String) {
+    let mut lines = text.lines();
+    let heading = lines
+        .next()
+        .and_then(|l| l.strip_prefix("# "))
+        .expect("the CSV's first line names the machine")
+        .to_string();
+    assert_eq!(lines.next(), Some(CSV_HEADER), "the CSV's columns");
+    let rows = lines
+        .map(|l| {
+            // The setting is quoted (its name has commas), the error too.
+            let (setting, rest) = l[1..].split_once("\",").expect("a quoted setting");
+            let f: Vec<&str> = std::iter::once(setting)
+                .chain(rest.splitn(10, ','))
+                .collect();
+            let num = |i: usize| f[i].parse::<f64>().expect("a number");
+            let result = if f[10].is_empty() {
+                Ok([num(4), num(5), num(7), num(8), num(9)])
+            } else {
+                Err(f[10].trim_matches('"').to_string())
+            };
+            Row {
+                setting: f[0].to_string(),
+                dim: f[1].parse().expect("a dimension"),
+                fill: num(2),
+                dp: num(3),
+                result,
+            }
+        })
+        .collect();
+    (rows, heading)
+}
+
+/// The manual's table and figure from `rows`.
+fn write(root: &Path, rows: &[Row], heading: &str, png: Option<String>) {
+    let mut table = format!(
+        "Wall seconds measured on {heading}. Free decay of a 1 cm first-mode wave over eight periods; the \
+         period and ζ fitted to the horizontal force after the first period.\n\n\
+         | setting | dim | fill m | dp mm | period s | theory s | error | ζ | laminar ζ | wall s |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n"
+    );
+    for r in rows {
+        table += &table_row(r);
+        table.push('\n');
+    }
+    let page = root.join("docs/src/validation/sloshing.md");
+    let text = std::fs::read_to_string(&page).expect("docs/src/validation/sloshing.md");
+    let (begin, end) = ("<!-- convergence:begin -->\n", "<!-- convergence:end -->");
+    let a = text.find(begin).expect("the convergence:begin marker") + begin.len();
+    let b = text[a..].find(end).expect("the convergence:end marker") + a;
+    std::fs::write(&page, format!("{}{table}{}", &text[..a], &text[b..])).unwrap();
+    let svg = root.join("docs/src/images/convergence.svg");
+    let fig = convergence_figure(rows);
+    figure::draw(
+        SVGBackend::new(&svg, (1400, 1000)).into_drawing_area(),
+        &fig,
+    )
+    .unwrap();
+    if let Some(png) = png {
+        figure::draw(
+            BitMapBackend::new(&png, (1400, 1000)).into_drawing_area(),
+            &fig,
+        )
+        .unwrap();
+    }
+    println!(
+        "wrote {}, convergence.csv and {}",
+        page.display(),
+        svg.display()
+    );
+}
+
+fn table_row(r: &Row) -> String {
+    let head = format!(
+        "| {} | {}D | {} | {:.0} |",
+        r.setting,
+        r.dim,
+        r.fill,
+        r.dp * 1000.0
+    );
+    match &r.result {
+        Ok([t, t0, z, zl, w]) => format!(
+            "{head} {t:.4} | {t0:.4} | {:+.2} % | {z:.4} | {zl:.5} | {w:.0} |",
+            100.0 * (t / t0 - 1.0)
+        ),
+        Err(e) => format!("{head} failed: {e} | | | | | |"),
+    }
+}
+
+/// Period error and damping ratio against the spacing, a panel each per dimension; a line per setting and
+/// fill, the laminar damping dashed.
+fn convergence_figure(rows: &[Row]) -> Figure {
+    let mut panels = Vec::new();
+    for dim in [2, 3] {
+        let mut period = Panel {
+            title: format!("{dim}D: first-mode period against linear theory"),
+            y_label: "period error (%)".into(),
+            x_label: "particle spacing dp (mm)".into(),
+            markers: true,
+            level: Some((0.0, "linear theory".into())),
+            ..Default::default()
+        };
+        let mut damping = Panel {
+            title: format!("{dim}D: damping ratio"),
+            y_label: "ζ".into(),
+            x_label: "particle spacing dp (mm)".into(),
+            markers: true,
+            ..Default::default()
+        };
+        for s in &SETTINGS {
+            for fill in FILLS {
+                let points: Vec<(f64, [f64; 5])> = rows
+                    .iter()
+                    .filter(|r| r.setting == s.name && r.dim == dim && r.fill == fill)
+                    .filter_map(|r| r.result.as_ref().ok().map(|v| (r.dp * 1000.0, *v)))
+                    .collect();
+                if points.is_empty() {
+                    continue;
+                }
+                let label = format!("{}, fill {fill} m", s.name);
+                let x: Vec<f64> = points.iter().map(|p| p.0).collect();
+                period.series.push(Series {
+                    label: label.clone(),
+                    t: x.clone(),
+                    y: points
+                        .iter()
+                        .map(|p| 100.0 * (p.1[0] / p.1[1] - 1.0))
+                        .collect(),
+                    reference: false,
+                });
+                damping.series.push(Series {
+                    label,
+                    t: x,
+                    y: points.iter().map(|p| p.1[2]).collect(),
+                    reference: false,
+                });
+            }
+        }
+        for fill in FILLS {
+            let laminar: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.dim == dim && r.fill == fill)
+                .filter_map(|r| r.result.as_ref().ok().map(|v| (r.dp * 1000.0, v[3])))
+                .collect();
+            if let (Some(lo), Some(hi)) = (
+                laminar.iter().map(|p| p.0).reduce(f64::min),
+                laminar.iter().map(|p| p.0).reduce(f64::max),
+            ) {
+                damping.series.push(Series {
+                    label: format!("laminar theory, fill {fill} m"),
+                    t: vec![lo, hi],
+                    y: vec![laminar[0].1; 2],
+                    reference: true,
+                });
+            }
+        }
+        if !period.series.is_empty() {
+            panels.push(period);
+            panels.push(damping);
+        }
+    }
+    Figure {
+        title: "Seed tank, first sloshing mode: free decay against linear theory".into(),
+        panels,
+        columns: 2,
+    }
+}
