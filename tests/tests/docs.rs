@@ -273,3 +273,203 @@ fn the_performance_tables_are_made_from_the_benchmark_records() {
     generated("README.md", "bench", &table);
     generated("docs/src/performance/benchmarks.md", "bench", &table);
 }
+
+/// A row of a parameter table of the user guide: the keys its first column names, and its default column
+/// ("" where the table has none).
+struct ParamRow {
+    keys: Vec<String>,
+    default: String,
+}
+
+/// The parameter tables of the user guide: tables whose head's first cell says `key` or `parameter`. The
+/// first column names keys as `a.b`, `.c` (a sibling of the item before it), `a.{x,y}` (each of x, y),
+/// `a.<name>.b` (any name); a table whose head names a group (`key (under `wave_maker.`)`) names its members
+/// relative to it, and the group itself. Returns the rows, and the groups whose members a default
+/// configuration does not have (named members, or an optional group).
+fn parameter_tables() -> (Vec<ParamRow>, BTreeSet<String>) {
+    let (mut rows, mut groups) = (Vec::new(), BTreeSet::new());
+    let mut files = Vec::new();
+    pages(&root().join("docs/src/guide"), &mut files);
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let (mut under, mut in_table, mut read, mut with_default) =
+            (String::new(), false, false, false);
+        for line in prose(&text) {
+            let Some(cells) = line
+                .strip_prefix('|')
+                .map(|l| l.split('|').collect::<Vec<_>>())
+            else {
+                (under, in_table, read) = (String::new(), false, false);
+                continue;
+            };
+            let cell = cells[0];
+            if !in_table {
+                // The table's head.
+                in_table = true;
+                let head = cell.trim_start();
+                read = head.starts_with("key") || head.starts_with("parameter");
+                with_default = cells.get(1).is_some_and(|c| c.trim() == "default");
+                if let Some(group) = cell.split('`').nth(1).filter(|g| read && g.ends_with('.')) {
+                    under = group.to_string();
+                    let group = group.trim_end_matches('.');
+                    rows.push(ParamRow {
+                        keys: vec![group.to_string()],
+                        default: String::new(),
+                    });
+                    if !group.contains(".<") {
+                        groups.insert(group.to_string());
+                    }
+                }
+                continue;
+            }
+            if !read || cell.starts_with("---") {
+                continue;
+            }
+            let mut keys = Vec::new();
+            let mut parent = String::new();
+            for (i, item) in cell.split('`').enumerate() {
+                if i % 2 == 0 || item.is_empty() {
+                    continue;
+                }
+                let full = match item.strip_prefix('.') {
+                    Some(rest) if !parent.is_empty() => format!("{parent}.{rest}"),
+                    _ => format!("{under}{item}"),
+                };
+                if let Some(p) = full.rfind('.') {
+                    parent = full[..p].to_string();
+                }
+                if let Some(i) = full.find(".<") {
+                    groups.insert(full[..i].to_string());
+                }
+                match (full.find(".{"), full.strip_suffix('}')) {
+                    (Some(b), Some(body)) => {
+                        for member in body[b + 2..].split(',') {
+                            keys.push(format!("{}.{}", &full[..b], member.trim()));
+                        }
+                    }
+                    _ => keys.push(full),
+                }
+            }
+            let default = if with_default {
+                cells.get(1).map_or("", |c| c.trim()).to_string()
+            } else {
+                String::new()
+            };
+            rows.push(ParamRow { keys, default });
+        }
+    }
+    (rows, groups)
+}
+
+/// The value a default cell gives, where it is a plain value: a number (what leads the cell: "0 (off)" is
+/// 0), `a name`, true/false, [] (anything else, e.g. "by scheme", gives None).
+fn default_value(cell: &str) -> Option<serde_json::Value> {
+    let cell = cell.trim();
+    if let Some(name) = cell.strip_prefix('`').and_then(|c| c.strip_suffix('`')) {
+        return Some(serde_json::json!(name));
+    }
+    match cell {
+        "true" | "false" => return Some(serde_json::json!(cell == "true")),
+        "[]" => return Some(serde_json::json!([])),
+        _ => {}
+    }
+    let lead = cell.split([' ', '(']).next()?;
+    lead.parse::<f64>().ok().map(|x| serde_json::json!(x))
+}
+
+/// Dotted paths of the leaves of `v` (an array, or an object with no members, is a leaf).
+fn leaves(v: &serde_json::Value, at: &str, out: &mut BTreeSet<String>) {
+    match v {
+        serde_json::Value::Object(m) if !m.is_empty() => {
+            for (k, v) in m {
+                let path = if at.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{at}.{k}")
+                };
+                leaves(v, &path, out);
+            }
+        }
+        _ => {
+            out.insert(at.to_string());
+        }
+    }
+}
+
+#[test]
+fn the_parameter_reference_names_every_parameter_and_only_those() {
+    let case = "/**:\n  ros__parameters:\n    dimension: 2\n    tank: {length: 0.8, breadth: 0.25, height: 0.6}\n    fill_height: 0.19\n    particle_spacing: 0.02\n";
+    let loaded = slosh_node::config::from_str(case, "case.yaml", None, &[]).unwrap();
+    let params = loaded.sim_params().unwrap();
+    let mut every = BTreeSet::new();
+    leaves(&loaded.effective_parameters(&params), "", &mut every);
+    // Groups of named members (`obstacles.<name>.centre`) and optional groups document the group's key.
+    let (rows, named_groups) = parameter_tables();
+    let documented: BTreeSet<String> = rows.iter().flat_map(|r| r.keys.iter().cloned()).collect();
+    let undocumented: Vec<&String> = every
+        .iter()
+        .filter(|k| !documented.contains(*k) && !named_groups.contains(*k))
+        .collect();
+    assert!(
+        undocumented.is_empty(),
+        "parameters the user guide's tables do not name: {undocumented:?}"
+    );
+    // What the tables name under a parameter group must be a parameter.
+    let tops: BTreeSet<&str> = every.iter().map(|k| k.split('.').next().unwrap()).collect();
+    let unknown: Vec<&String> = documented
+        .iter()
+        .filter(|k| {
+            k.chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || "_.".contains(c))
+                && k.contains('.')
+                && tops.contains(k.split('.').next().unwrap())
+                && !every.contains(*k)
+                && !named_groups.iter().any(|g| k.starts_with(&format!("{g}.")))
+        })
+        .collect();
+    assert!(
+        unknown.is_empty(),
+        "the user guide's tables name parameters that do not exist: {unknown:?}"
+    );
+    // And give their defaults: a cell of one value for every key of its row, or one per key.
+    let effective = loaded.effective_parameters(&params);
+    let given = ["dimension", "tank", "fill_height", "particle_spacing"];
+    let (mut checked, mut wrong) = (0, Vec::new());
+    for r in rows.iter().filter(|r| !r.default.is_empty()) {
+        let cells: Vec<&str> = r.default.split(", ").collect();
+        for (i, key) in r.keys.iter().enumerate() {
+            let cell = if cells.len() == r.keys.len() {
+                cells[i]
+            } else {
+                r.default.as_str()
+            };
+            let (Some(want), Some(got)) = (
+                default_value(cell),
+                key.split('.')
+                    .try_fold(&effective, |v, k| v.get(k))
+                    .filter(|_| !given.contains(&key.split('.').next().unwrap())),
+            ) else {
+                continue;
+            };
+            checked += 1;
+            let same = match (want.as_f64(), got.as_f64()) {
+                (Some(a), Some(b)) => (a - b).abs() <= 1e-9 * b.abs().max(1e-12),
+                _ => &want == got,
+            };
+            if !same {
+                wrong.push(format!(
+                    "{key}: the table says {cell}, the default is {got}"
+                ));
+            }
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "defaults the tables get wrong:\n{}",
+        wrong.join("\n")
+    );
+    assert!(
+        checked >= 60,
+        "only {checked} defaults read from the tables"
+    );
+}
