@@ -13,51 +13,51 @@ use std::path::{Path, PathBuf};
 pub const BUILTIN: &[(&str, &str)] = &[
     (
         "seed_tank_039",
-        include_str!("../../launch-configs/seed_tank_039.yaml"),
+        include_str!("../launch-configs/seed_tank_039.yaml"),
     ),
     (
         "seed_tank_019",
-        include_str!("../../launch-configs/seed_tank_019.yaml"),
+        include_str!("../launch-configs/seed_tank_019.yaml"),
     ),
     (
         "dambreak_2d",
-        include_str!("../../launch-configs/dambreak_2d.yaml"),
+        include_str!("../launch-configs/dambreak_2d.yaml"),
     ),
     (
         "faltinsen2000_sway",
-        include_str!("../../launch-configs/faltinsen2000_sway.yaml"),
+        include_str!("../launch-configs/faltinsen2000_sway.yaml"),
     ),
     (
         "spheric10",
-        include_str!("../../launch-configs/spheric10.yaml"),
+        include_str!("../launch-configs/spheric10.yaml"),
     ),
     (
         "akyildiz2006_pitch",
-        include_str!("../../launch-configs/akyildiz2006_pitch.yaml"),
+        include_str!("../launch-configs/akyildiz2006_pitch.yaml"),
     ),
     (
         "bouscasse2013_shallow",
-        include_str!("../../launch-configs/bouscasse2013_shallow.yaml"),
+        include_str!("../launch-configs/bouscasse2013_shallow.yaml"),
     ),
     (
         "kleefsman2005_dambreak",
-        include_str!("../../launch-configs/kleefsman2005_dambreak.yaml"),
+        include_str!("../launch-configs/kleefsman2005_dambreak.yaml"),
     ),
     (
         "flooding_case_a",
-        include_str!("../../launch-configs/flooding_case_a.yaml"),
+        include_str!("../launch-configs/flooding_case_a.yaml"),
     ),
     (
         "flooding_case_b",
-        include_str!("../../launch-configs/flooding_case_b.yaml"),
+        include_str!("../launch-configs/flooding_case_b.yaml"),
     ),
     (
         "flooding_case_c",
-        include_str!("../../launch-configs/flooding_case_c.yaml"),
+        include_str!("../launch-configs/flooding_case_c.yaml"),
     ),
     (
         "flooding_3d_compartment",
-        include_str!("../../launch-configs/flooding_3d_compartment.yaml"),
+        include_str!("../launch-configs/flooding_3d_compartment.yaml"),
     ),
 ];
 
