@@ -501,8 +501,8 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
         // reads as damaged to the MCAP reader's checks, not as valid messages.
         let bytes =
             unsafe { memmap2::Mmap::map(&f) }.map_err(|e| bad(file, format!("cannot map: {e}")))?;
-        // A chunk claiming an impossible size ends what is recovered (the reader would try to allocate it).
-        let (readable, oversized) = crate::mcap_bounds::readable(&bytes);
+        // A damaged chunk (an impossible size, records that do not fit) ends what is recovered (the reader would try to allocate what it claims).
+        let (readable, damaged) = crate::mcap_bounds::readable(&bytes);
         let stream = mcap::MessageStream::new_with_options(
             readable,
             mcap::read::Options::IgnoreEndMagic.into(),
@@ -530,15 +530,15 @@ pub fn repair(input: &Path, out: &Path) -> Result<Repaired, RecordError> {
                     n += 1;
                 }
                 Err(e) => {
-                    // (Where a chunk claimed an impossible size the read part ends there: that is why.)
-                    let why = oversized.map_or_else(|| e.to_string(), |o| o.to_string());
+                    // (Where a chunk was damaged the read part ends there: that is why.)
+                    let why = damaged.map_or_else(|| e.to_string(), |o| o.to_string());
                     stops.push(where_(file, why));
                     stopped = true;
                     break;
                 }
             }
         }
-        if let (false, Some(o)) = (stopped, oversized) {
+        if let (false, Some(o)) = (stopped, damaged) {
             stops.push(where_(file, o.to_string()));
         }
     }

@@ -1,1 +1,3 @@
 //! End-to-end and validation tests live in `tests/tests/`.
+
+pub mod fuzz;

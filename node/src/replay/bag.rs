@@ -121,9 +121,9 @@ pub fn for_each_message(
                 "not an MCAP file (it does not start with the MCAP magic bytes); slosh reads rosbag2 bags stored as MCAP",
             ));
         }
-        // A chunk claiming an impossible size ends what is read (the reader would try to allocate it).
-        let (readable, oversized) = crate::mcap_bounds::readable(&map);
-        let options = if oversized.is_some() {
+        // A damaged chunk (an impossible size, records that do not fit) ends what is read (the reader would try to allocate what it claims).
+        let (readable, damaged) = crate::mcap_bounds::readable(&map);
+        let options = if damaged.is_some() {
             mcap::read::Options::IgnoreEndMagic.into()
         } else {
             Default::default()
@@ -136,7 +136,7 @@ pub fn for_each_message(
         })?;
         let mut n = 0;
         for next in stream.map(Some).chain(std::iter::once(None)) {
-            let cause = match (next, oversized) {
+            let cause = match (next, damaged) {
                 (Some(Ok(m)), _) => {
                     visit(&m)?;
                     n += 1;
