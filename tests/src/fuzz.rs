@@ -12,7 +12,6 @@ use slosh_node::config::{self, Loaded};
 use slosh_node::iox::{self, MotionSample};
 use slosh_node::replay::motion::{self, Reading};
 use slosh_node::ros::frames::Frames;
-use slosh_node::ros::live_motion::Limits;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
@@ -323,18 +322,7 @@ pub fn bags(n: usize, rng: &mut Rng, seed: &[u8], cfg: &Loaded) -> Tally {
         |rng| mutate(seed, rng),
         |input| {
             std::fs::write(&path, input).map_err(|e| e.to_string())?;
-            let how = Reading {
-                topic: None,
-                stamp: c.input.stamp,
-                bad_samples: c.replay.bad_samples,
-                limits: Limits {
-                    max_speed: c.input.max_speed,
-                    max_rotation_rate: c.input.max_rotation_rate,
-                },
-                max_gap_s: c.input.max_gap_s,
-                frames: &frames,
-                gravity: 9.81,
-            };
+            let how = Reading::of(c, &frames, None, 9.81);
             let files = slosh_node::replay::bag::files(&path).map_err(|e| e.to_string())?;
             let m = motion::read(&path, &files, &how).map_err(|e| e.to_string())?;
             let _ = m.motion.state(0.0);

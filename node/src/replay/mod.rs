@@ -10,7 +10,6 @@ use crate::output::Summary;
 use crate::record::{output_topics, RecordCfg, Recorder};
 use crate::ros::frames::Frames;
 use crate::ros::gravity_check::{GravityCheck, InputKind};
-use crate::ros::live_motion::Limits;
 use crate::runner::{drive, Drive, RecordState, RunError, RunOptions};
 use bag::BagError;
 use slosh_msgs::builtin_interfaces::Time;
@@ -95,18 +94,7 @@ pub fn replay(
     let params = cfg.sim_params()?;
     let files = bag::files(bag_path)?;
     let frames = Frames::new(c.input.world_frame, c.input.body_frame, c.frames.tank_pose);
-    let how = motion::Reading {
-        topic: opts.topic.as_deref(),
-        stamp: c.input.stamp,
-        bad_samples: c.replay.bad_samples,
-        limits: Limits {
-            max_speed: c.input.max_speed,
-            max_rotation_rate: c.input.max_rotation_rate,
-        },
-        max_gap_s: c.input.max_gap_s,
-        frames: &frames,
-        gravity: params.gravity,
-    };
+    let how = motion::Reading::of(c, &frames, opts.topic.as_deref(), params.gravity);
     let bm = motion::read(bag_path, &files, &how)?;
     let record_cfg = if c.record.path.is_empty() {
         RecordCfg {

@@ -69,6 +69,29 @@ pub struct Reading<'a> {
     pub gravity: f64,
 }
 
+impl<'a> Reading<'a> {
+    /// As the case `c` says (its `input.*` and `replay.*`), through `frames`, for `topic`.
+    pub fn of(
+        c: &crate::config::RunConfig,
+        frames: &'a Frames,
+        topic: Option<&'a str>,
+        gravity: f64,
+    ) -> Self {
+        Reading {
+            topic,
+            stamp: c.input.stamp,
+            bad_samples: c.replay.bad_samples,
+            limits: Limits {
+                max_speed: c.input.max_speed,
+                max_rotation_rate: c.input.max_rotation_rate,
+            },
+            max_gap_s: c.input.max_gap_s,
+            frames,
+            gravity,
+        }
+    }
+}
+
 /// The motion read from a bag.
 pub struct BagMotion {
     pub motion: Box<dyn TankMotion>,
