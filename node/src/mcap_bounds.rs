@@ -76,10 +76,12 @@ pub fn first_damaged_chunk(bytes: &[u8]) -> Option<Damaged> {
         let op = bytes[at];
         let len = u64_at(bytes, at + 1)?;
         let body = at + 9;
-        let end = body.checked_add(usize::try_from(len).ok()?)?;
-        if end > bytes.len() || op == DATA_END || op == FOOTER {
+        let end = body.saturating_add(usize::try_from(len).unwrap_or(usize::MAX));
+        if op == DATA_END || op == FOOTER {
             return None;
         }
+        // (A chunk is checked even where its stated length runs past the end of the file: the reader
+        // starts decompressing what there is.)
         if op == CHUNK {
             // message_start_time, message_end_time, uncompressed_size, uncompressed_crc, compression
             // (u32 length + bytes), records (u64 length + bytes).
@@ -101,10 +103,17 @@ pub fn first_damaged_chunk(bytes: &[u8]) -> Option<Damaged> {
                 return damaged(Damage::Size);
             }
             let start = body + 40 + name;
-            let records = bytes.get(start..start.checked_add(usize::try_from(stored).ok()?)?)?;
+            let stop = start.saturating_add(usize::try_from(stored).unwrap_or(usize::MAX));
+            let Some(records) = bytes.get(start..stop) else {
+                // Fewer bytes than the chunk stores: the reader would decompress a part.
+                return damaged(Damage::Undecodable);
+            };
             if let Some(damage) = inner_damage(compression, records, claimed) {
                 return damaged(damage);
             }
+        }
+        if end > bytes.len() {
+            return None;
         }
         at = end;
     }
@@ -290,6 +299,29 @@ mod tests {
             first_damaged_chunk(&b2).map(|d| d.damage),
             Some(Damage::Undecodable)
         );
+    }
+
+    #[test]
+    fn a_chunk_running_past_the_end_is_checked_too() {
+        // A recording whose first chunk's record length was damaged to run past the end of the file, and
+        // whose chunk records hold a damaged length inside (found by the fuzzing too).
+        let b = include_bytes!("../tests/data/chunk_past_the_end.mcap");
+        let (part, damaged) = readable(b);
+        let d = damaged.expect("caught");
+        assert_eq!(d.offset, chunks(b)[0], "{d}");
+        assert_eq!(
+            mcap::MessageStream::new_with_options(part, mcap::read::Options::IgnoreEndMagic.into())
+                .unwrap()
+                .count(),
+            0
+        );
+        // A sound file cut inside a chunk: the cut chunk is refused before the reader decompresses a part.
+        let sound = bag(50, 2000);
+        let second = chunks(&sound)[1];
+        // (One byte into its records: opcode and length, three times and a u32, the name "zstd", a u64.)
+        let cut = &sound[..second + 9 + 32 + 4 + 8 + 1];
+        let d = first_damaged_chunk(cut).expect("caught");
+        assert_eq!((d.offset, d.damage), (second, Damage::Undecodable));
     }
 
     #[test]
