@@ -13,15 +13,15 @@ pub const SLACK: u64 = 1 << 20;
 pub const MAX_CHUNK: u64 = 1 << 32;
 
 const CHUNK: u8 = 0x06;
-const DATA_END: u8 = 0x0F;
 const FOOTER: u8 = 0x02;
 
-/// A chunk the reader must not be given.
+/// A chunk (or record) the reader must not be given.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Damaged {
     /// Byte offset of the chunk record in the file.
     pub offset: usize,
-    /// Its stated uncompressed size and its stored records' length, bytes.
+    /// Its stated uncompressed size and its stored records' length, bytes (for [`Damage::Length`], the
+    /// record's stated length and 0).
     pub claimed: u64,
     pub stored: u64,
     /// What is wrong with it.
@@ -37,6 +37,9 @@ pub enum Damage {
     /// A record inside claims more bytes than the chunk has left after it (`at`: its offset in the
     /// uncompressed records).
     Record { at: u64, length: u64 },
+    /// A record of the file (chunk or not) claims a length that overflows the reader's arithmetic
+    /// (`claimed`).
+    Length,
 }
 
 impl std::fmt::Display for Damaged {
@@ -50,6 +53,10 @@ impl std::fmt::Display for Damaged {
             Damage::Undecodable => write!(
                 f,
                 "the chunk at byte {at} does not decompress to the {claimed} bytes it states (damaged compressed data)"
+            ),
+            Damage::Length => write!(
+                f,
+                "the record at byte {at} claims {claimed} bytes (a damaged length field)"
             ),
             Damage::Record { at: inner, length } => write!(
                 f,
@@ -77,8 +84,18 @@ pub fn first_damaged_chunk(bytes: &[u8]) -> Option<Damaged> {
         let len = u64_at(bytes, at + 1)?;
         let body = at + 9;
         let end = body.saturating_add(usize::try_from(len).unwrap_or(usize::MAX));
-        if op == DATA_END || op == FOOTER {
+        if op == FOOTER {
             return None;
+        }
+        if len > (usize::MAX - 9) as u64 {
+            // The reader's arithmetic on it (opcode and length, 9 bytes, plus the length) overflows. (The
+            // summary section after the data end is walked too: the reader parses it.)
+            return Some(Damaged {
+                offset: at,
+                claimed: len,
+                stored: 0,
+                damage: Damage::Length,
+            });
         }
         // (A chunk is checked even where its stated length runs past the end of the file: the reader
         // starts decompressing what there is.)
@@ -170,6 +187,8 @@ pub fn readable(bytes: &[u8]) -> (&[u8], Option<Damaged>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const DATA_END: u8 = 0x0F;
 
     /// A small MCAP file of `n` messages in zstd chunks of ~`chunk` bytes.
     fn bag(n: usize, chunk: u64) -> Vec<u8> {
@@ -322,6 +341,22 @@ mod tests {
         let cut = &sound[..second + 9 + 32 + 4 + 8 + 1];
         let d = first_damaged_chunk(cut).expect("caught");
         assert_eq!((d.offset, d.damage), (second, Damage::Undecodable));
+    }
+
+    #[test]
+    fn a_record_longer_than_the_file_is_caught_in_the_summary_too() {
+        // A recording whose summary holds a record claiming 2^64 - 1 bytes: the reader's 9 + length
+        // wrapped round and it panicked slicing (found by the fuzzing).
+        let b = include_bytes!("../tests/data/summary_length.mcap");
+        let d = first_damaged_chunk(b).expect("caught");
+        assert_eq!(d.damage, Damage::Length, "{d}");
+        let (part, _) = readable(b);
+        let n =
+            mcap::MessageStream::new_with_options(part, mcap::read::Options::IgnoreEndMagic.into())
+                .unwrap()
+                .take_while(|m| m.is_ok())
+                .count();
+        assert!(n > 0, "the messages before it read: {n}");
     }
 
     #[test]
