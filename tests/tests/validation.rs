@@ -61,6 +61,14 @@ fn figure_panels(name: &str, title: &str, panels: Vec<Panel>) -> Vec<PathBuf> {
         );
         eprintln!("validation figure: {}", f.display());
     }
+    // The manual shows the figures of the run that last updated it (SLOSH_UPDATE_DOCS=1).
+    if std::env::var_os("SLOSH_UPDATE_DOCS").is_some() {
+        let docs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/src/images/validation");
+        std::fs::create_dir_all(&docs).unwrap();
+        for f in files.iter().filter(|f| f.extension().is_some_and(|x| x == "png")) {
+            std::fs::copy(f, docs.join(f.file_name().unwrap())).unwrap();
+        }
+    }
     files
 }
 
