@@ -65,7 +65,10 @@ fn figure_panels(name: &str, title: &str, panels: Vec<Panel>) -> Vec<PathBuf> {
     if std::env::var_os("SLOSH_UPDATE_DOCS").is_some() {
         let docs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/src/images/validation");
         std::fs::create_dir_all(&docs).unwrap();
-        for f in files.iter().filter(|f| f.extension().is_some_and(|x| x == "png")) {
+        for f in files
+            .iter()
+            .filter(|f| f.extension().is_some_and(|x| x == "png"))
+        {
             std::fs::copy(f, docs.join(f.file_name().unwrap())).unwrap();
         }
     }
