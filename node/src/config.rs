@@ -88,7 +88,7 @@ pub enum ConfigError {
 
 const DOF_NAMES: &str = "x, y, z, roll, pitch, yaw";
 
-/// An opening in a floating body's walls or an internal wall (see [`sph::body::RegionSpec`]).
+/// An opening in a floating body's walls or an internal wall (see [`sph::params::RegionSpec`]).
 #[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct OpeningCfg {
@@ -98,7 +98,7 @@ pub struct OpeningCfg {
     pub size: [f64; 3],
 }
 
-/// A spring holding a floating body (see [`sph::body::SpringSpec`]).
+/// A spring holding a floating body (see [`sph::params::SpringSpec`]).
 #[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpringCfg {
@@ -112,7 +112,7 @@ pub struct SpringCfg {
     pub rest_length: f64,
 }
 
-/// A floating body under `bodies.NAME` (see [`sph::body::BodySpec`]); openings and springs are maps by
+/// A floating body under `bodies.NAME` (see [`sph::params::BodySpec`]); openings and springs are maps by
 /// name, as ROS 2 parameters nest.
 #[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
@@ -129,7 +129,7 @@ pub struct BodyCfg {
     #[serde(default)]
     pub angular_velocity: [f64; 3],
     #[serde(default)]
-    pub fixed: Vec<sph::body::Dof>,
+    pub fixed: Vec<sph::params::Dof>,
     #[serde(default)]
     pub openings: std::collections::BTreeMap<String, OpeningCfg>,
     /// Internal walls dividing the hollow, as boxes like the openings.
@@ -139,9 +139,9 @@ pub struct BodyCfg {
     pub springs: std::collections::BTreeMap<String, SpringCfg>,
 }
 
-fn regions(m: &std::collections::BTreeMap<String, OpeningCfg>) -> Vec<sph::body::RegionSpec> {
+fn regions(m: &std::collections::BTreeMap<String, OpeningCfg>) -> Vec<sph::params::RegionSpec> {
     m.iter()
-        .map(|(n, o)| sph::body::RegionSpec {
+        .map(|(n, o)| sph::params::RegionSpec {
             name: n.clone(),
             centre: o.centre,
             size: o.size,
@@ -150,8 +150,8 @@ fn regions(m: &std::collections::BTreeMap<String, OpeningCfg>) -> Vec<sph::body:
 }
 
 impl BodyCfg {
-    fn spec(&self, name: &str) -> sph::body::BodySpec {
-        sph::body::BodySpec {
+    fn spec(&self, name: &str) -> sph::params::BodySpec {
+        sph::params::BodySpec {
             name: name.to_string(),
             size: self.size,
             wall_thickness: self.wall_thickness,
@@ -167,7 +167,7 @@ impl BodyCfg {
             springs: self
                 .springs
                 .iter()
-                .map(|(n, k)| sph::body::SpringSpec {
+                .map(|(n, k)| sph::params::SpringSpec {
                     name: n.clone(),
                     attach: k.attach,
                     anchor: k.anchor,
@@ -291,7 +291,7 @@ pub struct RunConfig {
     pub bodies: std::collections::BTreeMap<String, BodyCfg>,
     /// A piston wave maker at the tank's −x end.
     #[serde(default)]
-    pub wave_maker: Option<sph::body::PistonSpec>,
+    pub wave_maker: Option<sph::params::PistonSpec>,
     /// Fixed obstacles by name: solid boxes of wall particles fixed to the tank, centre and size in the tank
     /// frame (origin at the centre of the tank bottom).
     #[serde(default)]

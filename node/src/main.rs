@@ -317,15 +317,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     // Under mpirun every rank runs this binary: rank 0 goes on with the command (its simulations spread
     // over all ranks), the others follow its solver calls until it is done.
     #[cfg(feature = "mpi")]
-    let _lead = match sph::domain::mpi::start(|| {
+    let _lead = match sph::distributed::mpi::start(|| {
         // mpirun passes SIGINT/SIGTERM to every rank; rank 0 finishes its outputs, then releases the
         // others: here the signals only set a flag nobody reads.
         let _ = ros::shutdown_flag();
     })
     .map_err(anyhow::Error::msg)?
     {
-        sph::domain::mpi::Role::Follow => return Ok(()),
-        sph::domain::mpi::Role::Lead(l) => {
+        sph::distributed::mpi::Role::Follow => return Ok(()),
+        sph::distributed::mpi::Role::Lead(l) => {
             if l.ranks() > 1 {
                 eprintln!("slosh: MPI with {} ranks", l.ranks());
             }

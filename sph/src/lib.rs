@@ -44,9 +44,11 @@
 
 pub mod body;
 pub mod boundary;
+pub mod distributed;
 pub mod domain;
 pub mod eos;
 pub mod error;
+pub mod fast;
 pub mod integrate;
 pub mod kernel;
 pub mod motion;
@@ -58,6 +60,20 @@ pub mod scheme;
 pub mod simulation;
 pub mod sloshing;
 pub mod tank;
+pub mod vector;
 
 pub use error::SimError;
-pub use simulation::{build, Counts, Simulation, Solver, Stats};
+pub use simulation::{Counts, Simulation, Solver, Stats};
+
+/// Builds the simulation the parameters ask for: in one process, or spread over the ranks of an MPI
+/// program ([`crate::domain::install`]; called on rank 0, the others follow in [`crate::distributed::serve`]).
+pub fn build(params: params::SimParams) -> Result<Box<dyn Solver>, SimError> {
+    params.validate()?;
+    match domain::world() {
+        Some(comm) => Ok(Box::new(distributed::Distributed::build(
+            comm.clone(),
+            params,
+        )?)),
+        None => simulation::build_local(params, None),
+    }
+}

@@ -1,40 +1,8 @@
 //! Tank geometry in the tank frame and the particle lattices that fill it. Axis k of a D-dimensional point is
-//! x, z in 2D and x, y, z in 3D; [`to3`] and [`from3`] convert.
+//! x, z in 2D and x, y, z in 3D; [`crate::vector::to3`] and [`crate::vector::from3`] convert.
 
 use crate::params::SimParams;
-
-/// A D-dimensional point or vector as x, y, z (y = 0 in 2D).
-#[inline(always)]
-pub fn to3<T: Copy + Default, const D: usize>(p: [T; D]) -> [T; 3] {
-    if D == 2 {
-        [p[0], T::default(), p[1]]
-    } else {
-        [p[0], p[1], p[2]]
-    }
-}
-
-/// The D-dimensional part of an x, y, z triple.
-#[inline(always)]
-pub fn from3<T: Copy + Default, const D: usize>(p: [T; 3]) -> [T; D] {
-    let mut out = [T::default(); D];
-    if D == 2 {
-        out[0] = p[0];
-        out[1] = p[2];
-    } else {
-        out.copy_from_slice(&p);
-    }
-    out
-}
-
-/// The cross product a × b.
-#[inline(always)]
-pub fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+use crate::vector::from3;
 
 /// The inside of the tank as an axis-aligned box in the tank frame.
 #[derive(Clone, Copy, Debug)]
@@ -45,9 +13,11 @@ pub struct TankBox<const D: usize> {
 
 impl<const D: usize> TankBox<D> {
     pub fn new(p: &SimParams) -> Self {
-        let lo = from3([-p.tank.length / 2.0, -p.tank.breadth / 2.0, 0.0]);
-        let hi = from3([p.tank.length / 2.0, p.tank.breadth / 2.0, p.tank.height]);
-        Self { lo, hi }
+        let (lo, hi) = p.tank.inside();
+        Self {
+            lo: from3(lo),
+            hi: from3(hi),
+        }
     }
 
     pub fn contains(&self, x: [f64; D]) -> bool {
@@ -112,14 +82,6 @@ pub fn wall_lattice<const D: usize>(p: &SimParams, layers: u32) -> (Vec<[f64; D]
     (out, volume)
 }
 
-/// Whether `x` (tank frame) lies within the obstacle box grown by `margin` on every side (in 2D along x and z).
-pub fn in_obstacle<const D: usize>(o: &crate::body::RegionSpec, x: [f64; D], margin: f64) -> bool {
-    let x = to3(x);
-    let axes: &[usize] = if D == 2 { &[0, 2] } else { &[0, 1, 2] };
-    axes.iter()
-        .all(|&k| (x[k] - o.centre[k]).abs() < 0.5 * o.size[k] + margin)
-}
-
 /// The points of the tank's wall lattice (the inside continued, so they line up with the wall layers) that
 /// fill the obstacles: solid blocks of wall particles fixed to the tank.
 pub fn obstacle_lattice<const D: usize>(p: &SimParams) -> Vec<[f64; D]> {
@@ -140,7 +102,7 @@ pub fn obstacle_lattice<const D: usize>(p: &SimParams) -> Vec<[f64; D]> {
                 x
             })
         })
-        .filter(|x| p.obstacles.iter().any(|o| in_obstacle(o, *x, 0.0)))
+        .filter(|x| p.obstacles.iter().any(|o| o.within(*x, 0.0)))
         .collect()
 }
 
@@ -157,8 +119,8 @@ pub fn wall_spacing<const D: usize>(p: &SimParams) -> [f64; D] {
 /// reads them.
 pub fn obstacle_as_built<const D: usize>(
     p: &SimParams,
-    o: &crate::body::RegionSpec,
-) -> crate::body::RegionSpec {
+    o: &crate::params::RegionSpec,
+) -> crate::params::RegionSpec {
     let tank = TankBox::<D>::new(p);
     let mut out = o.clone();
     for k in 0..D {
@@ -220,7 +182,7 @@ mod tests {
     #[test]
     fn an_obstacle_is_built_from_the_wall_lattice_points_inside_it() {
         let mut p = params(3);
-        let o = crate::body::RegionSpec {
+        let o = crate::params::RegionSpec {
             name: "block".into(),
             centre: [0.0215, 0.0, 0.0415],
             size: [0.103, 0.1, 0.083],

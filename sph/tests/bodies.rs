@@ -2,9 +2,10 @@
 //! its heave and roll periods in free decay fall where the restoring stiffness and plausible added masses
 //! put them, and water pours into a fixed damaged box at the rate of the orifice law. 2D, dp = 5 mm.
 
-use sph::body::{BodySpec, BodyState, Dof, RegionSpec};
+use sph::body::BodyState;
 use sph::motion::AtRest;
 use sph::params::*;
+use sph::params::{BodySpec, Dof, RegionSpec};
 use sph::Solver;
 
 mod common;
@@ -246,7 +247,7 @@ fn a_piston_wave_maker_makes_the_waves_of_linear_theory() {
     p.tank.height = 0.35;
     p.fill.height = h;
     p.particle_spacing = 0.01;
-    p.wave_maker = Some(sph::body::PistonSpec {
+    p.wave_maker = Some(sph::params::PistonSpec {
         stroke,
         period,
         ramp_time: 2.0 * period,

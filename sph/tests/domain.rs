@@ -108,7 +108,7 @@ fn ranks_as_threads_reproduce_one_process() {
         let mut p = case(scheme, method);
         p.solver.dfsph.kernel_correction = corrected;
         if obstacle {
-            p.obstacles = vec![sph::body::RegionSpec {
+            p.obstacles = vec![sph::params::RegionSpec {
                 name: "block".into(),
                 centre: [0.05, 0.0, 0.05],
                 size: [0.1, 0.25, 0.1],

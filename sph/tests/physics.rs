@@ -868,7 +868,7 @@ fn steps_land_on_the_requested_times_without_slivers() {
 #[test]
 fn an_obstacle_on_the_floor_holds_the_liquid_at_rest_and_carries_its_weight() {
     let (dp, fill) = (0.01, 0.15);
-    let block = sph::body::RegionSpec {
+    let block = sph::params::RegionSpec {
         name: "block".into(),
         centre: [0.0, 0.0, 0.0415],
         size: [0.103, 0.25, 0.083],
@@ -981,12 +981,12 @@ fn an_obstacle_on_the_floor_holds_the_liquid_at_rest_and_carries_its_weight() {
 /// tank, or with mirror walls (they are made of wall particles); so is a pressure sensor buried in one.
 #[test]
 fn obstacles_that_would_not_work_are_refused_by_name() {
-    let base = sph::body::RegionSpec {
+    let base = sph::params::RegionSpec {
         name: "block".into(),
         centre: [0.0, 0.0, 0.04],
         size: [0.1, 0.25, 0.08],
     };
-    let refused = |o: sph::body::RegionSpec, method: BoundaryMethod| {
+    let refused = |o: sph::params::RegionSpec, method: BoundaryMethod| {
         let mut p = tank2d(0.4, 0.3, 0.15, 0.01);
         p.solver.boundary.method = method;
         p.obstacles = vec![o];

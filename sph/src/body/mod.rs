@@ -3,15 +3,11 @@
 //! body particle index) and act on the liquid as walls do; the liquid's reaction on them is summed into a
 //! force and moment on each body ([`coupling`]) and integrated with its mass and inertia ([`rigid`]).
 
-pub mod coupling;
 pub mod piston;
 pub mod rigid;
 pub mod shell;
-pub mod spec;
 
-pub use piston::PistonSpec;
 pub use rigid::RigidBody;
-pub use spec::{BodySpec, Dof, RegionSpec, SpringSpec};
 
 use crate::particles::{Boundary, NOT_BODY};
 use nalgebra::Vector3;
@@ -65,8 +61,8 @@ impl Bodies {
             let (x, v) = self.list[b as usize].particle(i as usize);
             let s = self.slots[g] as usize;
             let (x, v): ([f64; D], [f64; D]) = (
-                crate::tank::from3([x.x, x.y, x.z]),
-                crate::tank::from3([v.x, v.y, v.z]),
+                crate::vector::from3([x.x, x.y, x.z]),
+                crate::vector::from3([v.x, v.y, v.z]),
             );
             for d in 0..D {
                 bound.x[d][s] = x[d] as f32;

@@ -6,9 +6,8 @@
 //! absolute angular velocity): I dΩ/dt + Ω × I Ω = M about the centre of gravity, so
 //! dω/dt = I⁻¹ (M − Ω × I Ω) − ω̇_frame − ω_frame × ω. Fixed degrees of freedom get no acceleration.
 
-use super::piston::PistonSpec;
-use super::spec::{BodySpec, Dof};
-use crate::scheme::FrameTerms;
+use crate::motion::FrameTerms;
+use crate::params::{BodySpec, Dof, PistonSpec};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 type V3 = Vector3<f64>;
@@ -409,7 +408,7 @@ mod tests {
     #[test]
     fn spring_oscillates_at_its_natural_period() {
         let mut s = spec();
-        s.springs.push(crate::body::spec::SpringSpec {
+        s.springs.push(crate::params::SpringSpec {
             name: "k".into(),
             attach: [0.0, 0.0, 0.05],
             anchor: [0.0, 0.0, 0.15],

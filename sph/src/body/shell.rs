@@ -1,7 +1,7 @@
 //! The particles of a hollow box: every lattice point of the box within `wall_thickness` of its outer
 //! faces or in a bulkhead, less those in an opening.
 
-use super::spec::BodySpec;
+use crate::params::BodySpec;
 
 /// Lattice points of the body's walls in box coordinates (x, y, z; y = 0 in 2D). The spacing along each
 /// axis is the one nearest `dp` that fits the box exactly.
@@ -57,7 +57,7 @@ pub fn covers(spec: &BodySpec, dimension: usize, p: [f64; 3], margin: f64) -> bo
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body::spec::RegionSpec;
+    use crate::params::RegionSpec;
 
     fn spec() -> BodySpec {
         BodySpec {

@@ -389,7 +389,7 @@ impl Domain {
     }
 }
 
-impl<const D: usize> crate::scheme::Ranks<D> for Domain {
+impl<const D: usize> super::Ranks<D> for Domain {
     fn total(&self) -> usize {
         self.fluid_total
     }

@@ -6,7 +6,7 @@
 //! state) and copies of its particles within two columns (one kernel support) of a neighbour's slab, the
 //! neighbour's halo; between sorts (the weakly-compressible half step, the incompressible pressure
 //! iterations) only the halo copies' values are refreshed in place ([`Domain::refresh`],
-//! [`crate::scheme::Ranks`]). The wall particles are the same on every rank; the neighbours' halo walls get
+//! [`Ranks`]). The wall particles are the same on every rank; the neighbours' halo walls get
 //! their densities from their owner. Halo copies are marked in their id ([`crate::particles::HALO`]) and
 //! left out of every pass and total.
 //!
@@ -16,22 +16,22 @@
 //! Totals (wall force and moment) are summed over ranks, so they differ from the serial sums only by the
 //! order of the additions. Observables are computed by the rank whose slab holds the probe or sensor.
 //!
-//! Every rank runs the same calls: rank 0 drives a [`Distributed`] solver that broadcasts each call (and the
-//! tank motion, step by step) to the other ranks, which [`serve`] until rank 0 stops them. The transport is
+//! Every rank runs the same calls: rank 0 drives a [`crate::distributed::Distributed`] solver that broadcasts
+//! each call (and the tank motion, step by step) to the other ranks, which [`crate::distributed::serve`] until
+//! rank 0 stops them. The transport is
 //! the small [`Comm`] trait; `mpi` implements it with MPI (cargo feature `mpi`).
 
 mod exchange;
 #[cfg(feature = "mpi")]
 pub mod mpi;
-mod service;
 mod slabs;
 pub mod threads;
 
 pub use exchange::Domain;
-pub use service::{comm_seconds, install, ranks, serve, shutdown, world, Distributed};
 pub use slabs::Slabs;
 
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// A reduction.
@@ -40,6 +40,17 @@ pub enum Op {
     Sum,
     Min,
     Max,
+}
+
+/// What a scheme needs across ranks (the MPI domain decomposition); `None` in one process.
+pub trait Ranks<const D: usize> {
+    /// Liquid particles on all ranks.
+    fn total(&self) -> usize;
+    /// The halo copies' values of a per-particle scalar, and of a per-particle vector, from their owners.
+    fn sync_scalar(&mut self, k: &mut [f32]);
+    fn sync_vector(&mut self, v: &mut [[f32; D]]);
+    /// Element-wise sum or extreme over ranks.
+    fn reduce(&mut self, v: &mut [f64], op: Op);
 }
 
 /// What the decomposition needs from the transport between ranks. Every call is collective: all ranks make
@@ -102,4 +113,29 @@ impl<C: Comm> Comm for Timed<C> {
     fn seconds(&self) -> f64 {
         self.nanos.load(Ordering::Relaxed) as f64 * 1e-9
     }
+}
+
+pub(crate) static WORLD: OnceLock<Arc<dyn Comm>> = OnceLock::new();
+
+/// Makes [`crate::build`] decompose every simulation over `comm`'s ranks (once per process, by the program
+/// that started MPI; a world of one rank changes nothing).
+pub fn install(comm: Arc<dyn Comm>) {
+    if WORLD.set(comm).is_err() {
+        panic!("sph::domain::install called twice");
+    }
+}
+
+/// The installed ranks, if there is more than one.
+pub fn world() -> Option<&'static Arc<dyn Comm>> {
+    WORLD.get().filter(|c| c.size() > 1)
+}
+
+/// Seconds this rank has spent communicating and waiting for the others (0 without ranks).
+pub fn comm_seconds() -> f64 {
+    world().map_or(0.0, |c| c.seconds())
+}
+
+/// Number of ranks the simulations run on.
+pub fn ranks() -> usize {
+    world().map_or(1, |c| c.size())
 }

@@ -3,11 +3,13 @@
 //! world never enter the particle arithmetic (a tank kilometres from the origin behaves like one at it).
 
 mod coupled;
+mod frame;
 mod irregular;
 mod regular;
 mod sampled;
 
 pub use coupled::CoupledMotion;
+pub use frame::FrameTerms;
 pub use irregular::{IrregularMotion, JonswapDof};
 pub use regular::{RegularDof, RegularMotion};
 pub use sampled::{SampleError, SampledMotion};

@@ -3,11 +3,12 @@
 //! incompressible scheme, whose liquid particles next to a wall carry the wall's share of the pressure as
 //! well, so interpolating their pressure would over-read.
 
-use crate::body::RegionSpec;
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, NO_RANGES};
+use crate::params::RegionSpec;
 use crate::particles::{Boundary, Fluid};
-use crate::tank::{from3, TankBox};
+use crate::tank::TankBox;
+use crate::vector::from3;
 
 /// The wall face a pressure sensor sits on.
 #[derive(Clone, Copy, Debug, PartialEq)]

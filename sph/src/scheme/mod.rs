@@ -1,61 +1,64 @@
-//! Pressure schemes. Each scheme evaluates the rates of change of the liquid (and of the wall particles'
-//! density) from the current state; the integrator and the simulation are shared.
+//! Pressure schemes: how a step finds the liquid's pressure and moves it. Each scheme implements
+//! [`PressureScheme`] in a folder of its own, named for its method: [`wcsph`] (weakly-compressible SPH, the
+//! seed paper's) and [`dfsph`] (divergence-free SPH, Bender & Koschier). Both advance the same [`State`]
+//! (the liquid, the walls, the bodies, this rank's part of a decomposition) and share its stages (the frame
+//! terms of the motion, sorting, the bodies); the simulation ([`crate::Simulation`]) holds one state and one
+//! scheme and reads the observables of both alike.
+//!
+//! A new scheme (or a backend on other hardware) is a type that implements [`PressureScheme`], a
+//! [`crate::params::Scheme`] variant, and its branch in [`crate::Simulation::new_in`].
 
-pub mod candidates;
+pub mod coupling;
 pub mod dfsph;
-pub mod gradient_correction;
-pub mod half;
 pub mod landing;
-pub mod near;
-pub mod pair_sums;
-pub mod warm_start;
+pub mod state;
 pub mod wcsph;
+
+pub use state::{State, Stats};
+
+use crate::error::SimError;
+use crate::kernel::Kernel;
+use crate::motion::TankMotion;
+use crate::observe::wall_pressure::FaceSpot;
+
+/// A pressure scheme: one step of the liquid in a moving tank, and what the observables need of it.
+pub trait PressureScheme<const D: usize, K: Kernel>: Send {
+    /// Advances the state one time step, no further than the motion's end or the state's step limit;
+    /// returns the step's length.
+    fn step(&mut self, s: &mut State<D, K>, motion: &dyn TankMotion) -> Result<f64, SimError>;
+
+    /// Makes the pressures and the walls' force belong to the current state (after the last step, or a
+    /// change of state such as new velocities), and sorts the liquid for the observables' neighbour sums.
+    fn prepare_observation(
+        &mut self,
+        s: &mut State<D, K>,
+        motion: &dyn TankMotion,
+    ) -> Result<(), SimError>;
+
+    /// The tank walls' force and moment on the liquid to report now (per unit breadth in 2D); a scheme that
+    /// reports a mean over the steps since the last observation starts a new mean.
+    fn wall_wrench(&mut self, s: &State<D, K>) -> ([f64; 3], [f64; 3]);
+
+    /// The pressure a sensor on a wall face reads when the scheme has a wall pressure of its own (the push of
+    /// the liquid on the wall particles behind the sensor; across ranks, this rank's walls' part, those
+    /// where `mine`); `None`: the liquid's pressure interpolated at the face.
+    fn face_pressure(
+        &self,
+        s: &State<D, K>,
+        spot: &FaceSpot<D>,
+        mine: &dyn Fn(f64) -> bool,
+    ) -> Option<f64>;
+
+    /// Liquid particle a's pressure, for particle frames.
+    fn liquid_pressure(&self, s: &State<D, K>, a: usize) -> f32;
+
+    /// A wall particle's pressure and density for particle frames, from its density `rho`.
+    fn wall_reading(&self, s: &State<D, K>, rho: f32) -> (f32, f32);
+}
 
 /// Particles per parallel work item of every scheme's passes (fixed, so reductions do not depend on the
 /// number of threads).
 pub const CHUNK: usize = 256;
-
-/// What a scheme needs across ranks (MPI domain decomposition, [`crate::domain`]); `None` in one process.
-pub trait Ranks<const D: usize> {
-    /// Liquid particles on all ranks.
-    fn total(&self) -> usize;
-    /// The halo copies' values of a per-particle scalar, and of a per-particle vector, from their owners.
-    fn sync_scalar(&mut self, k: &mut [f32]);
-    fn sync_vector(&mut self, v: &mut [[f32; D]]);
-    /// Element-wise sum or extreme over ranks.
-    fn reduce(&mut self, v: &mut [f64], op: crate::domain::Op);
-}
-
-/// The tank frame's motion as the particles feel it, in the tank frame (x, y, z).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct FrameTerms {
-    /// Apparent gravity R^T (g − a_origin), m/s².
-    pub g: [f32; 3],
-    /// Angular velocity ω, rad/s.
-    pub w: [f32; 3],
-    /// Angular acceleration ω̇, rad/s².
-    pub dw: [f32; 3],
-}
-
-impl FrameTerms {
-    /// Acceleration of a particle at r moving at v relative to the frame, from gravity and the frame's motion:
-    /// g − ω̇ × r − ω × (ω × r) − 2 ω × v.
-    #[inline(always)]
-    pub fn acceleration(&self, r: [f32; 3], v: [f32; 3]) -> [f32; 3] {
-        let cross = |a: [f32; 3], b: [f32; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let euler = cross(self.dw, r);
-        let wr = cross(self.w, r);
-        let centri = cross(self.w, wr);
-        let cor = cross(self.w, v);
-        std::array::from_fn(|k| self.g[k] - euler[k] - centri[k] - 2.0 * cor[k])
-    }
-}
 
 /// What one force evaluation found, summed over the liquid.
 #[derive(Clone, Copy, Debug, Default)]

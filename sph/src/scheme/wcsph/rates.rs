@@ -5,13 +5,14 @@
 //! Gather form: every liquid particle loops over its neighbours in cell-sorted order and writes only its own
 //! rates, so threads never share a write; chunks of fixed size make the sums independent of the thread count.
 
-use super::candidates::{lane_sum, share_room, wide_lanes, Candidates, LANES};
-use super::{FrameTerms, PassTotals, CHUNK};
+use crate::fast::candidates::{lane_sum, share_room, wide_lanes, Candidates, LANES};
 use crate::kernel::Kernel;
+use crate::motion::FrameTerms;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
 use crate::params::DiffusionKind;
 use crate::particles::{Boundary, Fluid, HALO};
-use crate::tank::{cross, from3, to3};
+use crate::scheme::{PassTotals, CHUNK};
+use crate::vector::{cross, from3, to3};
 use rayon::prelude::*;
 
 /// Constants of the scheme in the precision of the loops.
@@ -483,7 +484,7 @@ mod tests {
             nu4: 0.0,
         };
         // A jittered lattice of 7^D particles around the origin, with made-up velocities and densities.
-        let mut rnd = super::super::candidates::test_noise(12345);
+        let mut rnd = crate::fast::candidates::test_noise(12345);
         let n1 = 7usize;
         let n = n1.pow(D as u32);
         let mut x: [Vec<f32>; D] = std::array::from_fn(|_| Vec::new());

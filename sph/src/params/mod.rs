@@ -1,6 +1,12 @@
 //! The typed description of a case: tank, liquid, resolution, solver choices and observation points.
 //! Plain data with defaults; [`SimParams::validate`] names the offending field of anything unusable.
 
+mod bodies;
+mod wave_maker;
+
+pub use bodies::{BodySpec, Dof, RegionSpec, SpringSpec};
+pub use wave_maker::PistonSpec;
+
 use crate::kernel::{KernelGradient, KernelKind};
 use serde::{Deserialize, Serialize};
 
@@ -15,6 +21,14 @@ pub struct TankSpec {
     pub breadth: f64,
     /// m, along z.
     pub height: f64,
+}
+
+impl TankSpec {
+    /// The tank's inside in x, y, z (tank frame: origin at the centre of the bottom), lower and upper corner.
+    pub fn inside(&self) -> ([f64; 3], [f64; 3]) {
+        let (l, b) = (0.5 * self.length, 0.5 * self.breadth);
+        ([-l, -b, 0.0], [l, b, self.height])
+    }
 }
 
 /// Liquid properties.
@@ -74,10 +88,10 @@ pub struct DfsphSpec {
     pub target_iterations: u32,
     /// Share β of the hydrostatic pressure (per column of the liquid, below its highest particle) that the
     /// constant-density solve carries over whole from the last step; of the rest of the last pressure it
-    /// carries 0.6 (`sph::scheme::warm_start::REST`). 0: half the whole last pressure (Bender & Koschier 2017), as
+    /// carries 0.6 (`sph::scheme::dfsph::warm_start::REST`). 0: half the whole last pressure (Bender & Koschier 2017), as
     /// always with bodies (floating bodies, fixed or not, a wave maker) and with `smoothing_ratio` < 1.
     pub hydrostatic_warm_start: f64,
-    /// Correct the kernel gradients of the pressure passes (`sph::scheme::gradient_correction`: each
+    /// Correct the kernel gradients of the pressure passes (`sph::scheme::dfsph::gradient_correction`: each
     /// particle's gradients times the inverse of its Σ V (x_b − x_a) ⊗ ∇W, symmetrised over the pair), so
     /// that the liquid's pressure forces do not depend on its particles' arrangement. Without it a small
     /// sloshing wave sees a stiff, lossy lattice: the first mode runs short and dies out tens of times
@@ -317,14 +331,14 @@ pub struct SimParams {
     pub pressure_sensors: Vec<SensorSpec>,
     /// Floating bodies in the tank (which then serves as the basin around them).
     #[serde(default)]
-    pub bodies: Vec<crate::body::BodySpec>,
+    pub bodies: Vec<BodySpec>,
     /// A piston wave maker at the tank's −x end.
     #[serde(default)]
-    pub wave_maker: Option<crate::body::PistonSpec>,
+    pub wave_maker: Option<PistonSpec>,
     /// Fixed obstacles: solid boxes of wall particles fixed to the tank (a block on the floor, a baffle), by
     /// centre and size in the tank frame (origin at the centre of the tank bottom).
     #[serde(default)]
-    pub obstacles: Vec<crate::body::RegionSpec>,
+    pub obstacles: Vec<RegionSpec>,
 }
 
 /// A parameter that cannot be used, with the field's dotted name and what would be accepted.
@@ -467,14 +481,8 @@ impl SimParams {
         } else {
             self.wall_layers() as f64 * dp
         };
-        let face = crate::body::piston::rest_face(wm, -0.5 * self.tank.length, thickness, dp);
+        let face = wm.rest_face(-0.5 * self.tank.length, thickness, dp);
         Some((thickness, face))
-    }
-
-    /// The tank's inside in x, y, z (tank frame: origin at the centre of the bottom), lower and upper corner.
-    fn tank_inside(&self) -> ([f64; 3], [f64; 3]) {
-        let t = crate::tank::TankBox::<3>::new(self);
-        (t.lo, t.hi)
     }
 
     /// Obstacles lie within the tank, are at least a kernel support thick (the liquid must not see through
@@ -490,7 +498,7 @@ impl SimParams {
             ));
         }
         let support = 2.0 * self.h();
-        let (lo, hi) = self.tank_inside();
+        let (lo, hi) = self.tank.inside();
         let axes: &[usize] = if self.dimension == 2 {
             &[0, 2]
         } else {
@@ -565,7 +573,7 @@ impl SimParams {
             ));
         }
         let support = 2.0 * self.h();
-        let (lo, hi) = self.tank_inside();
+        let (lo, hi) = self.tank.inside();
         for (i, b) in self.bodies.iter().enumerate() {
             let ok = b.name.starts_with(|c: char| c.is_ascii_alphabetic())
                 && b.name
@@ -828,12 +836,12 @@ impl SimParams {
             }
             // On an obstacle's face (within half a spacing) it reads that face; deeper, it would be
             // inside the solid.
-            let inside = |o: &crate::body::RegionSpec| {
+            let inside = |o: &RegionSpec| {
                 let margin = -0.5 * self.particle_spacing;
                 if self.dimension == 2 {
-                    crate::tank::in_obstacle::<2>(o, [p.x, p.z], margin)
+                    o.within::<2>([p.x, p.z], margin)
                 } else {
-                    crate::tank::in_obstacle::<3>(o, [p.x, p.y, p.z], margin)
+                    o.within::<3>([p.x, p.y, p.z], margin)
                 }
             };
             if let Some(o) = self.obstacles.iter().find(|o| inside(o)) {

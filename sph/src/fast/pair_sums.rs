@@ -464,7 +464,7 @@ mod avx {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scheme::candidates::wide_lanes;
+    use crate::fast::candidates::wide_lanes;
 
     /// A made-up list of `len` neighbours among 50 particles (lanes beyond 3 zero, as the solver keeps
     /// them), their gradients as half records and velocities, and k.

@@ -2,11 +2,11 @@
 //! body's particles put on the liquid in [`crate::scheme::wcsph`], pair by pair, so the liquid and the bodies
 //! exchange equal and opposite forces.
 
+use super::wcsph::Coefficients;
 use crate::kernel::Kernel;
 use crate::neighbours::{Grid, NO_RANGES};
 use crate::particles::{Boundary, Fluid, HALO};
-use crate::scheme::wcsph::Coefficients;
-use crate::tank::to3;
+use crate::vector::to3;
 use rayon::prelude::*;
 
 /// Calls `pair(j, dx, vd, r2)` for every liquid particle j of this rank (halo copies, MPI, are left out:
@@ -87,7 +87,7 @@ pub fn liquid_forces<const D: usize, K: Kernel>(
 #[allow(clippy::too_many_arguments)]
 pub fn liquid_forces_dfsph<const D: usize, K: Kernel>(
     k: &K,
-    c: &crate::scheme::dfsph::Coefficients,
+    c: &super::dfsph::Coefficients,
     grid: &Grid<D>,
     fluid: &Fluid<D>,
     bound: &Boundary<D>,
@@ -114,7 +114,7 @@ pub fn liquid_forces_dfsph<const D: usize, K: Kernel>(
                     let ka = kappa(j);
                     for d in 0..D {
                         // Liquid particle j's acceleration from the body particle, and its reaction.
-                        let acc = -crate::scheme::dfsph::MIRROR * ka * p.m_bound * gf * dx[d]
+                        let acc = -super::dfsph::MIRROR * ka * p.m_bound * gf * dx[d]
                             - p.m_bound * pi * gf * dx[d];
                         force[d] -= (p.m_fluid * acc) as f64;
                     }

@@ -5,7 +5,8 @@
 //! (x along `size[0]`, y along `size[1]`, z up). A 2D run uses the x and z parts of every triple, and its
 //! mass, inertia and spring stiffness are per metre of breadth (as the liquid's are).
 
-use crate::params::ParamError;
+use super::ParamError;
+use crate::vector::to3;
 use serde::{Deserialize, Serialize};
 
 /// A box in box coordinates: an opening (damage) cut from the walls, or an internal wall (a bulkhead or deck
@@ -293,6 +294,15 @@ impl BodySpec {
 }
 
 impl RegionSpec {
+    /// Whether `x` (a D-dimensional point, tank frame) lies within this region taken as an obstacle (centre and
+    /// size in the tank frame) grown by `margin` on every side (in 2D along x and z).
+    pub fn within<const D: usize>(&self, x: [f64; D], margin: f64) -> bool {
+        let x = to3(x);
+        let axes: &[usize] = if D == 2 { &[0, 2] } else { &[0, 1, 2] };
+        axes.iter()
+            .all(|&k| (x[k] - self.centre[k]).abs() < 0.5 * self.size[k] + margin)
+    }
+
     /// Its extent along axis `k`, box coordinates, m.
     fn bounds(&self, k: usize) -> (f64, f64) {
         (

@@ -2,39 +2,17 @@
 //! to the ranks in [`serve`], so that the program around the solver (files, topics, recordings) runs on rank
 //! 0 alone and unchanged.
 
-use super::Comm;
+#[cfg(feature = "mpi")]
+pub mod mpi;
+
+use crate::domain::{world, Comm, WORLD};
 use crate::motion::{AtRest, TankMotion};
 use crate::observe::snapshot::Snapshot;
 use crate::observe::Observation;
 use crate::params::SimParams;
 use crate::simulation::{Counts, Solver, Stats};
 use crate::SimError;
-use std::sync::{Arc, OnceLock};
-
-static WORLD: OnceLock<Arc<dyn Comm>> = OnceLock::new();
-
-/// Makes [`crate::build`] decompose every simulation over `comm`'s ranks (once per process, by the program
-/// that started MPI; a world of one rank changes nothing).
-pub fn install(comm: Arc<dyn Comm>) {
-    if WORLD.set(comm).is_err() {
-        panic!("sph::domain::install called twice");
-    }
-}
-
-/// The installed ranks, if there is more than one.
-pub fn world() -> Option<&'static Arc<dyn Comm>> {
-    WORLD.get().filter(|c| c.size() > 1)
-}
-
-/// Seconds this rank has spent communicating and waiting for the others (0 without ranks).
-pub fn comm_seconds() -> f64 {
-    world().map_or(0.0, |c| c.seconds())
-}
-
-/// Number of ranks the simulations run on.
-pub fn ranks() -> usize {
-    world().map_or(1, |c| c.size())
-}
+use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]

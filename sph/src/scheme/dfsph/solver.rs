@@ -1,62 +1,26 @@
-//! Divergence-free SPH (Bender & Koschier 2015, 2017): an incompressible scheme whose time step follows the
-//! flow speed, not the speed of sound. Each step
-//!
-//! 1. builds every liquid particle's list of liquid neighbours with their kernel gradients, sums the density,
-//!    the DFSPH factor α = 1 / (|Σ m∇W|² + Σ|m∇W|²), the walls' Σ m_b∇W (walls keep their velocity through
-//!    the step, so every wall term of the solver is this sum times the particle's own k or velocity, plus
-//!    the moving walls' constant Σ m_b v_b·∇W), and adds
-//!    the non-pressure accelerations (the tank frame's apparent gravity and rotation terms, Monaghan's
-//!    artificial viscosity as in the weakly-compressible scheme);
-//! 2. takes dt = CFL · dp / |v|max (also bounded by the accelerations, `dt_max`, and the iteration control:
-//!    0.8× the last step after one that needed more than `target_iterations`, growing back 1.1× a step);
-//! 3. makes the velocity field divergence-free (the divergence solver), then predicts v* = v + dt·a and
-//!    corrects it until the mean predicted density error is below the tolerance (the constant-density
-//!    solver). The divergence solve starts from half its last pressure, the constant-density solve from the
-//!    hydrostatic part of its last pressure whole and 0.6 of the rest (`warm_start`); both iterate
-//!    `k_i = ω · max(error_i, 0) · α_i / dt^n` (ω = `relaxation`, 0.7: at 1 the Jacobi iterations amplify
-//!    the particle-to-particle pressure modes of the 3D kernel's 81 neighbours and a tank at rest stirs
-//!    itself),
-//!    `Δv_i = −dt Σ_j m_j (k_i + k_j) ∇W_ij − dt Σ_b m_b k_i ∇W_ib` (k plays p/ρ², so p = ρ² Σ k);
-//!    A constant-density solve that stops at `max_iterations` above the tolerance is done again, with the
-//!    divergence solve, at half the step (nothing has moved yet);
-//! 4. moves the particles with the corrected velocity.
-//!
-//! Walls are the dynamic boundary's particle layers (at rest in the tank frame, or moving with a floating
-//! body or a wave maker: their velocities enter the density rate and the viscosity), taking part in the
-//! density sums with their volume and pushing back with the liquid particle's own k (Akinci et al. 2012, as
-//! SPlisHSPlasH's DFSPH). Their reaction, summed once from the final k, gives the wrench; wall pressure
-//! sensors read the liquid's force on the wall particles (`observe::wall_pressure`). The iterations reuse
-//! the neighbour lists; every pass is a gather over fixed chunks that writes only its own particles, so
-//! results do not depend on the number of threads.
+//! The divergence-free scheme's solver: the neighbourhood pass, the divergence and constant-density solves
+//! and the move of one step (see [`super`]).
 
-use super::candidates::{lane_sum, share_room, wide_lanes, Room, LANES};
 use super::gradient_correction::{self as correction, Mat};
-use super::half::Half4;
-use super::landing::landing_step;
-use super::near::Near;
-use super::pair_sums::Grad;
-use super::warm_start::{Columns, Setting};
-use super::{FrameTerms, PassTotals, Ranks, CHUNK};
-use crate::domain::Op;
+use super::warm_start::{Columns, Setting, WARM};
+use crate::domain::{Op, Ranks};
+use crate::fast::candidates::{lane_sum, share_room, wide_lanes, Room, LANES};
+use crate::fast::half::Half4;
+use crate::fast::near::Near;
+use crate::fast::pair_sums::Grad;
 use crate::kernel::Kernel;
+use crate::motion::FrameTerms;
 use crate::neighbours::{Grid, Ranges, NO_RANGES};
-use crate::params::DfsphSpec;
 use crate::particles::{Boundary, Fluid, HALO};
-use crate::tank::{cross, from3, to3};
+use crate::scheme::landing::landing_step;
+use crate::scheme::{PassTotals, State, CHUNK};
+use crate::vector::{cross, from3, to3};
 use rayon::prelude::*;
 
 /// How strongly walls push back on a liquid particle with k_i: `MIRROR · m_b k_i ∇W_ib` (1: Akinci et al.'s
 /// boundary term, as SPlisHSPlasH's DFSPH; full pressure mirroring, 2, stirs a tank at rest, relaxed
 /// iterations or not).
 pub const MIRROR: f32 = 1.0;
-
-/// Share of the last step's pressure the divergence solve starts from. Each iteration only adds pressure
-/// where the liquid is compressed (a monotone update that keeps the Jacobi iteration stable and never sucks
-/// liquid together), so a fuller warm start could never be undone where the flow relaxes. (Measured: a
-/// projected two-sided update from the full pressure with Chebyshev acceleration needs 2–3× fewer iterations,
-/// but its pressure field is noisy enough to shift the first sloshing mode's period by 5 %.) The
-/// constant-density solve carries the hydrostatic part of its last pressure whole (`warm_start`).
-pub(crate) const WARM: f32 = 0.5;
 
 /// Density errors are summed in units of 2^-20 kg/m³, as integers: the sum (and so the iteration count)
 /// does not depend on the order of the additions, which differs between one process and several ranks.
@@ -67,7 +31,7 @@ const ERR_SCALE: f64 = (1u64 << 20) as f64;
 pub struct Coefficients {
     /// The pair constants shared with the weakly-compressible scheme: h, support², masses, and the
     /// artificial viscosity's c0, α (liquid and wall pairs) and η².
-    pub pair: super::wcsph::Coefficients,
+    pub pair: crate::scheme::wcsph::Coefficients,
     /// The density the solver holds: the summed density of a particle inside the initial lattice.
     pub rho_rest: f32,
     /// Neighbours (liquid and wall) a particle needs for the divergence solver to act on it (fewer: it is
@@ -421,7 +385,7 @@ unsafe fn store_block_avx2(
     // SAFETY: AVX2 and F16C (the caller); the loads read whole arrays of 8 lanes, the stores stay within
     // the room the caller guarantees; the table is 32-byte aligned.
     unsafe {
-        let perm = _mm256_load_si256(super::near::PACK.0[mask].as_ptr() as *const __m256i);
+        let perm = _mm256_load_si256(crate::fast::near::PACK.0[mask].as_ptr() as *const __m256i);
         let s = _mm256_set1_ps(scale);
         // (No closures here: a closure would not inherit AVX2, and the intrinsics would not be inlined.)
         let x = _mm256_permutevar8x32_ps(_mm256_mul_ps(_mm256_loadu_ps(gl[0].as_ptr()), s), perm);
@@ -1133,24 +1097,22 @@ fn merged(partials: &[Partial]) -> Partial {
     total
 }
 
-/// One DFSPH step of the sorted, refreshed liquid (`fluid.x`, `fluid.v` current): solves, then moves
-/// `fluid.pos`/`fluid.vel` (f64) by dt, or, when `prime` is set, only computes the pressures and wall force
-/// of the current state and leaves it where it is. Fills `fluid.r` (summed density) and `fluid.p`.
-#[allow(clippy::too_many_arguments)]
-pub fn step<'r, const D: usize, K: Kernel>(
-    kernel: &K,
-    c: &Coefficients,
-    spec: &DfsphSpec,
-    dp: f64,
-    grid: &Grid<D>,
-    frame: &FrameTerms,
-    fluid: &mut Fluid<D>,
-    bound: &Boundary<D>,
+/// One DFSPH step of the state's sorted, refreshed liquid (`fluid.x`, `fluid.v` current), at most
+/// `dt_limit` long: solves, then moves `fluid.pos`/`fluid.vel` (f64) by dt, or, when `prime` is set, only
+/// computes the pressures and wall force of the current state and leaves it where it is. Fills `fluid.r`
+/// (summed density) and `fluid.p`.
+pub fn step<const D: usize, K: Kernel>(
     work: &mut Workspace<D>,
+    s: &mut State<D, K>,
+    c: &Coefficients,
+    frame: &FrameTerms,
     dt_limit: f64,
     prime: bool,
-    mut ranks: Option<&mut (dyn Ranks<D> + 'r)>,
 ) -> StepReport {
+    let spec = &s.params.solver.dfsph;
+    let dp = s.params.particle_spacing;
+    let (kernel, grid, bound, fluid) = (&s.kernel, &s.grid, &s.bound, &mut s.fluid);
+    let mut ranks = s.dom.as_mut().map(|d| d as &mut dyn Ranks<D>);
     let n = fluid.len();
     work.resize(n);
     let p = Ctx {
@@ -1468,7 +1430,7 @@ mod tests {
         let h = 1.3 * dp;
         let k = K::new(D, h);
         let c = Coefficients {
-            pair: super::super::wcsph::Coefficients {
+            pair: crate::scheme::wcsph::Coefficients {
                 h,
                 support2: 4.0 * h * h,
                 m_fluid: 1000.0 * dp.powi(D as i32),
@@ -1491,7 +1453,7 @@ mod tests {
         };
         // A jittered lattice of 7^D liquid particles with made-up velocities, and a row of wall particles
         // through its lower half.
-        let mut rnd = super::super::candidates::test_noise(777);
+        let mut rnd = crate::fast::candidates::test_noise(777);
         let n1 = 7usize;
         let mut x: [Vec<f32>; D] = std::array::from_fn(|_| Vec::new());
         let mut v: [Vec<f32>; D] = std::array::from_fn(|_| Vec::new());

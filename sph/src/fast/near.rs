@@ -21,9 +21,9 @@ const FAR: f32 = 1.0e15;
 /// For each 8-bit mask of lanes, the set lanes in order (the rest: don't care), as the lane permutation
 /// that packs them to the front of a block.
 #[repr(align(32))]
-pub(super) struct Pack(pub(super) [[u32; LANES]; 1 << LANES]);
+pub(crate) struct Pack(pub(crate) [[u32; LANES]; 1 << LANES]);
 
-pub(super) static PACK: Pack = {
+pub(crate) static PACK: Pack = {
     let mut t = [[0u32; LANES]; 1 << LANES];
     let mut m = 0;
     while m < 1 << LANES {
