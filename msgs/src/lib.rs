@@ -1,5 +1,6 @@
 //! ROS 2 message types for slosh, with ROS 2's exact CDR layout, their `.msg` definitions and
-//! ROS type names.
+//! ROS type names; with the feature `iceoryx2`, the fixed-layout payloads of slosh's iceoryx2 services
+//! ([`iox`]).
 //!
 //! One module per ROS package. Every message type implements [`RosMessage`] (package, name,
 //! `.msg` text, dependencies, DDS type name, MCAP `ros2msg` schema); the services of
@@ -30,6 +31,8 @@ pub mod builtin_interfaces;
 pub mod cdr;
 pub mod diagnostic_msgs;
 pub mod geometry_msgs;
+#[cfg(feature = "iceoryx2")]
+pub mod iox;
 pub mod message;
 pub mod nav_msgs;
 pub mod rosgraph_msgs;

@@ -27,7 +27,7 @@ fn main() -> anyhow::Result<()> {
     let particles = particles_service(&node, &service)?
         .subscriber_builder()
         .create()?;
-    let stop = slosh_node::ros::shutdown_flag()?;
+    let stop = slosh_node::signals::shutdown_flag()?;
     let mut seen = 0u64;
     eprintln!("consumer: reading {service}/outputs and {service}/particles");
     while !stop.load(std::sync::atomic::Ordering::Relaxed) && (limit == 0 || seen < limit) {

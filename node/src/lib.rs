@@ -4,11 +4,14 @@
 // to catch NaN along with negatives.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod bag;
 pub mod bench;
 pub mod config;
+pub mod input;
 pub mod iox;
 pub mod mcap_bounds;
 pub mod memory;
+pub mod messages;
 pub mod motion_source;
 pub mod output;
 pub mod param_file;
@@ -19,5 +22,6 @@ pub mod replay;
 pub mod resolution;
 pub mod ros;
 pub mod runner;
+pub mod signals;
 pub mod snapshot;
 pub mod transport_bench;

@@ -320,7 +320,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     let _lead = match sph::distributed::mpi::start(|| {
         // mpirun passes SIGINT/SIGTERM to every rank; rank 0 finishes its outputs, then releases the
         // others: here the signals only set a flag nobody reads.
-        let _ = ros::shutdown_flag();
+        let _ = slosh_node::signals::shutdown_flag();
     })
     .map_err(anyhow::Error::msg)?
     {
@@ -384,7 +384,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             if !plain.is_empty() {
                 anyhow::bail!("unexpected arguments {plain:?}: ROS arguments go after --ros-args");
             }
-            let opts = ros::motion_pub::MotionOptions {
+            let opts = slosh_node::motion_source::MotionOptions {
                 rate_hz: rate,
                 duration,
                 pose,

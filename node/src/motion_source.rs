@@ -1,4 +1,5 @@
-//! Builds the tank motion a run asks for: none, regular, irregular (JONSWAP) or a CSV file of samples.
+//! Builds the tank motion a run asks for: none, regular, irregular (JONSWAP) or a CSV file of samples; and
+//! the checked motion of `slosh motion` (either transport).
 
 use crate::config::{Loaded, MotionSource};
 use sph::motion::{AtRest, IrregularMotion, RegularMotion, SampledMotion, TankMotion};
@@ -93,4 +94,78 @@ pub fn build(cfg: &Loaded) -> Result<Box<dyn TankMotion>, MotionError> {
         }
         MotionSource::Csv => Box::new(read_csv(&cfg.motion_file()?)?),
     })
+}
+
+/// Options of `slosh motion`.
+#[derive(Debug, Clone)]
+pub struct MotionOptions {
+    /// Samples per second.
+    pub rate_hz: f64,
+    /// Seconds of motion to publish.
+    pub duration: f64,
+    /// Also publish PoseStamped on `motion/pose`.
+    pub pose: bool,
+    /// Also publish sensor_msgs/Imu on `motion/imu` (an IMU at the vessel's frame origin).
+    pub imu: bool,
+    /// Also publish geometry_msgs/AccelStamped on `motion/accel` (body frame).
+    pub accel: bool,
+    /// Wait until this many subscribers are on `motion/odom` before the first sample (0: do not wait).
+    pub wait_for_subscribers: usize,
+    /// Publish ahead of a simulation's `/clock` by `lead` samples instead of pacing by the wall clock.
+    pub lockstep: bool,
+    /// Stamp of the first sample, s since the epoch (None: now).
+    pub start_stamp: Option<f64>,
+}
+
+impl MotionOptions {
+    /// The stamp of the first sample: `start_stamp`, or now (seconds since the epoch).
+    pub fn start_stamp(&self) -> f64 {
+        self.start_stamp.unwrap_or_else(|| {
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_secs_f64())
+                .unwrap_or(0.0)
+        })
+    }
+}
+
+/// The case (`config` with `params` overrides) and its motion, once `--rate` and `--duration` are checked and the
+/// motion lasts the duration (for either transport of `slosh motion`).
+pub fn checked_motion(
+    config: &str,
+    params: &[String],
+    opts: &MotionOptions,
+) -> anyhow::Result<(crate::config::Loaded, Box<dyn sph::motion::TankMotion>)> {
+    if !(opts.rate_hz.is_finite() && opts.rate_hz > 0.0) {
+        anyhow::bail!(
+            "--rate: must be a positive number of samples per second, got {}",
+            opts.rate_hz
+        );
+    }
+    if !(opts.duration.is_finite() && opts.duration > 0.0) {
+        anyhow::bail!(
+            "--duration: must be a positive number of seconds, got {}",
+            opts.duration
+        );
+    }
+    if let Some(s) = opts.start_stamp {
+        // builtin_interfaces/Time holds whole seconds in an i32: the last sample must fit too.
+        let last = s + opts.duration;
+        if !(s.is_finite() && s >= 0.0 && last < i32::MAX as f64) {
+            anyhow::bail!(
+                "--start-stamp: must be seconds since the epoch from 0 to {} (less --duration), got {s}",
+                i32::MAX
+            );
+        }
+    }
+    let cfg = crate::config::load(config, params)?;
+    let motion = build(&cfg)?;
+    if opts.duration > motion.end_time() {
+        anyhow::bail!(
+            "--duration {} s: the motion ends at t = {} s",
+            opts.duration,
+            motion.end_time()
+        );
+    }
+    Ok((cfg, motion))
 }

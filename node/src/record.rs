@@ -5,73 +5,13 @@
 //! [`Recorder::finish`] writes the summary and `metadata.yaml`; dropping an unfinished recorder finishes it, so
 //! a run that stops on an error still leaves a readable bag.
 
+use crate::config::{ChosenBy, RecordCfg};
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::RosMessage;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
-
-/// What `record.*` configures.
-#[derive(Debug, Clone, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RecordCfg {
-    /// rosbag2 folder to create (empty: no recording).
-    pub path: String,
-    /// `zstd` (default) or `none`.
-    pub compression: String,
-    /// Bytes of messages per chunk.
-    pub chunk_size: u64,
-    /// Seconds of log time after which the chunk being written is closed and written out even if it is
-    /// not full, so that a process killed hard loses at most about this much of its recording
-    /// (`slosh bag repair` recovers the rest); 0: only full chunks are written out.
-    pub flush_interval_s: f64,
-    /// Who chose `path` (for the error messages): `record.path`, or a command's output folder.
-    #[serde(skip)]
-    pub chosen_by: ChosenBy,
-}
-
-/// Where a bag's folder was chosen, which is what an error about it must name, with the fix.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub enum ChosenBy {
-    /// The case's `record.path`.
-    #[default]
-    RecordPath,
-    /// `slosh replay`'s output folder (its new bag goes to OUT/bag).
-    ReplayOut,
-    /// `slosh bag repair --out`.
-    RepairOut,
-}
-
-impl ChosenBy {
-    fn label(self) -> &'static str {
-        match self {
-            Self::RecordPath => "record.path",
-            Self::ReplayOut => "the replay's new bag (OUT/bag)",
-            Self::RepairOut => "the repaired bag (--out)",
-        }
-    }
-
-    fn choose_another(self) -> &'static str {
-        match self {
-            Self::RecordPath => "choose a new folder for record.path",
-            Self::ReplayOut => "choose another --out (or set record.path)",
-            Self::RepairOut => "choose another --out",
-        }
-    }
-}
-
-impl Default for RecordCfg {
-    fn default() -> Self {
-        Self {
-            path: String::new(),
-            compression: "zstd".into(),
-            chunk_size: 768 * 1024,
-            flush_interval_s: 1.0,
-            chosen_by: ChosenBy::RecordPath,
-        }
-    }
-}
 
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
@@ -352,14 +292,14 @@ impl Recorder {
         &mut self,
         topics: &[String; 3],
         log_time: Time,
-        m: &crate::ros::node::OutputMessages,
+        m: &crate::messages::OutputMessages,
     ) -> Result<(), RecordError> {
         self.write(&topics[0], log_time, &m.wrench)?;
         self.write(&topics[1], log_time, &m.probes)?;
         self.write(&topics[2], log_time, &m.pressures)?;
         let base = topics[0].rsplit_once('/').map_or("", |(ns, _)| ns);
         for b in &m.bodies {
-            let topic = |what| format!("{base}/{}", crate::ros::node::body_topic(&b.name, what));
+            let topic = |what| format!("{base}/{}", crate::messages::body_topic(&b.name, what));
             self.write(&topic("odom"), log_time, &b.odom)?;
             self.write(&topic("wrench"), log_time, &b.wrench)?;
         }
@@ -432,8 +372,8 @@ pub fn record_state(
     motion: &dyn sph::motion::TankMotion,
 ) -> Result<(), RecordError> {
     let stamp = slosh_msgs::builtin_interfaces::Time::from_secs_f64(o.time);
-    let m = crate::ros::node::output_messages(params, tank_frame, stamp, o);
-    let odom = crate::ros::motion_pub::odometry(&motion.state(o.time), stamp, "world", tank_frame);
+    let m = crate::messages::output_messages(params, tank_frame, stamp, o);
+    let odom = crate::messages::motion::odometry(&motion.state(o.time), stamp, "world", tank_frame);
     rec.write("/motion/odom", stamp, &odom)?;
     rec.write_outputs(&output_topics(), stamp, &m)
 }
@@ -601,7 +541,7 @@ fn repair_inputs(input: &Path) -> Result<Vec<PathBuf>, String> {
     if input.is_file() {
         return Ok(vec![input.to_path_buf()]);
     }
-    if let Ok(files) = crate::replay::bag::files(input) {
+    if let Ok(files) = crate::bag::files(input) {
         return Ok(files);
     }
     let mut mcaps: Vec<PathBuf> = std::fs::read_dir(input)
@@ -661,7 +601,7 @@ mod tests {
     /// The log times (s) of the messages of the MCAP files of the bag folder `dir`, read by the `mcap` crate.
     fn times(dir: &Path) -> Vec<u64> {
         let mut out = Vec::new();
-        for f in crate::replay::bag::files(dir).unwrap() {
+        for f in crate::bag::files(dir).unwrap() {
             let bytes = std::fs::read(f).unwrap();
             for m in mcap::MessageStream::new(&bytes).unwrap() {
                 out.push(m.unwrap().log_time / 1_000_000_000);
@@ -704,7 +644,7 @@ mod tests {
         let bytes = std::fs::read(&first).unwrap();
         std::fs::write(&first, &bytes[..bytes.len() * 2 / 3]).unwrap();
         let files = [first.clone(), split.join("split_1.mcap")];
-        let e = crate::replay::bag::for_each_message(&files, |_| Ok(()))
+        let e = crate::bag::for_each_message(&files, |_| Ok(()))
             .unwrap_err()
             .to_string();
         assert!(
@@ -712,7 +652,7 @@ mod tests {
             "{e}"
         );
         // One file alone: that file.
-        let e = crate::replay::bag::for_each_message(&files[..1], |_| Ok(()))
+        let e = crate::bag::for_each_message(&files[..1], |_| Ok(()))
             .unwrap_err()
             .to_string();
         assert!(
@@ -726,7 +666,7 @@ mod tests {
             "rosbag2_bagfile_information: {}\n",
         )
         .unwrap();
-        let e = crate::replay::bag::for_each_message(&files[..1], |_| Ok(()))
+        let e = crate::bag::for_each_message(&files[..1], |_| Ok(()))
             .unwrap_err()
             .to_string();
         assert!(

@@ -3,34 +3,11 @@
 //! runs the config's own `motion.*` (so it should resemble the motion expected live: a tank at rest steps
 //! faster than a sloshing one).
 
+use crate::config::AutoResolutionCfg;
 use crate::config::Loaded;
 use sph::params::SimParams;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
-
-/// What `realtime.auto_resolution.*` configures.
-#[derive(Debug, Clone, Copy, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct AutoResolutionCfg {
-    pub enabled: bool,
-    /// Coarsest spacing tried, m (0: 4 × `particle_spacing`). `particle_spacing` is the finest.
-    pub max_spacing: f64,
-    /// Simulated seconds of each trial.
-    pub trial_s: f64,
-    /// Real-time factor a spacing must reach in its trial to be chosen.
-    pub target_factor: f64,
-}
-
-impl Default for AutoResolutionCfg {
-    fn default() -> Self {
-        Self {
-            enabled: false,
-            max_spacing: 0.0,
-            trial_s: 0.3,
-            target_factor: 1.25,
-        }
-    }
-}
 
 /// The outcome: the spacing chosen, its measured real-time factor, and every trial (spacing, factor).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

@@ -2,9 +2,10 @@
 //! outputs as it goes, and always leave a summary — also when the solver fails.
 
 use crate::config::Loaded;
+use crate::config::RecordCfg;
 use crate::motion_source;
 use crate::output::{write_summary, CsvOutputs, Summary};
-use crate::record::{record_state, RecordCfg, RecordError, Recorder};
+use crate::record::{record_state, RecordError, Recorder};
 use crate::snapshot::{SnapshotOptions, SnapshotWriter};
 use indicatif::{ProgressBar, ProgressStyle};
 use sph::motion::TankMotion;
@@ -190,7 +191,7 @@ pub fn drive(
         time: 0.0,
         dir: out.display().to_string(),
     })?;
-    let stop = crate::ros::shutdown_flag().map_err(std::io::Error::other)?;
+    let stop = crate::signals::shutdown_flag().map_err(std::io::Error::other)?;
     let bar = progress_bar(opts.progress, duration);
     let start = Instant::now();
     let result = run_loop(

@@ -321,7 +321,7 @@ fn a_full_disk_stops_the_run_with_a_clear_error_and_keeps_the_csv_outputs() {
 fn an_empty_recording_is_read_by_rosbags_and_mcap() {
     // A node stopped before any motion arrived (a wrong remap) leaves a bag with no messages.
     let dir = common::tmp("record-empty");
-    let cfg = slosh_node::record::RecordCfg {
+    let cfg = slosh_node::config::RecordCfg {
         path: dir.join("bag").display().to_string(),
         ..Default::default()
     };

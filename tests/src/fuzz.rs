@@ -9,9 +9,9 @@
 //! target; `tests/tests/fuzz.rs` runs a few thousand in the test command.
 
 use slosh_node::config::{self, Loaded};
+use slosh_node::input::frames::Frames;
 use slosh_node::iox::{self, MotionSample};
 use slosh_node::replay::motion::{self, Reading};
-use slosh_node::ros::frames::Frames;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
@@ -323,7 +323,7 @@ pub fn bags(n: usize, rng: &mut Rng, seed: &[u8], cfg: &Loaded) -> Tally {
         |input| {
             std::fs::write(&path, input).map_err(|e| e.to_string())?;
             let how = Reading::of(c, &frames, None, 9.81);
-            let files = slosh_node::replay::bag::files(&path).map_err(|e| e.to_string())?;
+            let files = slosh_node::bag::files(&path).map_err(|e| e.to_string())?;
             let m = motion::read(&path, &files, &how).map_err(|e| e.to_string())?;
             let _ = m.motion.state(0.0);
             Ok(())
@@ -339,7 +339,7 @@ pub fn iox_samples(n: usize, rng: &mut Rng) -> Tally {
     let frames = Frames::new(
         Default::default(),
         Default::default(),
-        slosh_node::ros::frames::TankPose {
+        slosh_node::config::TankPose {
             x: 1.0,
             yaw: std::f64::consts::FRAC_PI_2,
             ..Default::default()

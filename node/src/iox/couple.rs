@@ -14,6 +14,7 @@
 use super::*;
 use crate::config::Loaded;
 use crate::output::CsvOutputs;
+use nalgebra::{UnitQuaternion, Vector3};
 use sph::motion::{CoupledMotion, TankMotion};
 use sph::observe::Observation;
 use std::path::PathBuf;
@@ -78,7 +79,7 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
         offset: Vector3::new(tp.x, tp.y, tp.z),
         rotation: UnitQuaternion::from_euler_angles(tp.roll, tp.pitch, tp.yaw),
     };
-    let limits = crate::ros::live_motion::Limits {
+    let limits = crate::input::live_motion::Limits {
         max_speed: cfg.config.input.max_speed,
         max_rotation_rate: cfg.config.input.max_rotation_rate,
     };
@@ -120,7 +121,7 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
         &opts.service,
         (opts.particles_hz > 0.0).then_some(total),
     )?;
-    let stop = crate::ros::shutdown_flag().map_err(std::io::Error::other)?;
+    let stop = crate::signals::shutdown_flag().map_err(std::io::Error::other)?;
     ready();
 
     let mut served = Served::default();
@@ -216,7 +217,7 @@ fn step(
     initial: &mut Option<StepOutputs>,
     s: &MotionSample,
     mount: &Mount,
-    limits: &crate::ros::live_motion::Limits,
+    limits: &crate::input::live_motion::Limits,
     dry: bool,
 ) -> (StepOutputs, Option<anyhow::Error>) {
     let reject = |msg: String| {
@@ -250,7 +251,7 @@ fn step(
             // The node's check of its iceoryx2 input.
             let last = m.state(m.newest());
             if let Err(e) =
-                crate::ros::live_state::check_jump(limits, t - m.newest(), &last, &state)
+                crate::input::live_state::check_jump(limits, t - m.newest(), &last, &state)
             {
                 return reject(e.to_string());
             }

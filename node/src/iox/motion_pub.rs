@@ -2,7 +2,7 @@
 //! paced by the wall clock, for a node with `input.type: iceoryx2` (no DDS involved).
 
 use super::*;
-use crate::ros::motion_pub::{checked_motion, MotionOptions};
+use crate::motion_source::{checked_motion, MotionOptions};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
@@ -21,7 +21,7 @@ pub fn run(
     let node = node("slosh_motion")?;
     let svc = motion_service(&node, service)?;
     let publisher = svc.publisher_builder().create()?;
-    let stop = crate::ros::shutdown_flag().map_err(std::io::Error::other)?;
+    let stop = crate::signals::shutdown_flag().map_err(std::io::Error::other)?;
     if opts.wait_for_subscribers > 0 {
         eprintln!(
             "slosh motion: waiting for {} subscriber(s) on iceoryx2 {service}/motion",

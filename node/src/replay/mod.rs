@@ -2,36 +2,18 @@
 //! time, writing the same CSV outputs as `slosh run` and a new bag with the motion as it was recorded plus
 //! every output, all on the source bag's time axis.
 
-pub mod bag;
 pub mod motion;
 
+use crate::bag::{self, BagError};
 use crate::config::Loaded;
+use crate::config::{ChosenBy, RecordCfg};
+use crate::input::frames::Frames;
+use crate::input::gravity_check::{GravityCheck, InputKind};
 use crate::output::Summary;
-use crate::record::{output_topics, RecordCfg, Recorder};
-use crate::ros::frames::Frames;
-use crate::ros::gravity_check::{GravityCheck, InputKind};
+use crate::record::{output_topics, Recorder};
 use crate::runner::{drive, Drive, RecordState, RunError, RunOptions};
-use bag::BagError;
 use slosh_msgs::builtin_interfaces::Time;
 use std::path::Path;
-
-/// What to do with a sample whose stamp repeats or goes back, that is not finite, or that jumps.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BadSamples {
-    /// Stop with an error naming the message.
-    #[default]
-    Error,
-    /// Skip the sample; the summary lists each one.
-    Drop,
-}
-
-/// What `replay.*` configures.
-#[derive(Debug, Clone, Default, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ReplayCfg {
-    pub bad_samples: BadSamples,
-}
 
 /// Options of one replay.
 #[derive(Debug, Clone, Default)]
@@ -76,7 +58,7 @@ pub struct Found {
     /// The new recording.
     pub recording: String,
     /// The frame conventions' plausibility check over the first half second (see
-    /// [`crate::ros::gravity_check`]): `ok` or its warning.
+    /// [`crate::input::gravity_check`]): `ok` or its warning.
     pub input_check: String,
 }
 
@@ -99,7 +81,7 @@ pub fn replay(
     let record_cfg = if c.record.path.is_empty() {
         RecordCfg {
             path: out.join("bag").display().to_string(),
-            chosen_by: crate::record::ChosenBy::ReplayOut,
+            chosen_by: ChosenBy::ReplayOut,
             ..c.record.clone()
         }
     } else {
@@ -152,7 +134,7 @@ pub fn replay(
             next += 1;
         }
         let stamp = Time::from_nanos(stamp_ns);
-        let m = crate::ros::node::output_messages(&params, &tank_frame, stamp, o);
+        let m = crate::messages::output_messages(&params, &tank_frame, stamp, o);
         r.write_outputs(&topics, stamp, &m)
     };
     let run = RunOptions {

@@ -3,13 +3,13 @@
 //! its header stamp or its log time, applies the bad-sample policy, and turns the samples into the tank's
 //! motion through the same frame conventions as the live node.
 
-use super::bag::{for_each_message, BagError};
-use super::BadSamples;
+use crate::bag::{for_each_message, BagError};
+use crate::config::BadSamples;
 use crate::config::StampSource;
-use crate::ros::frames::Frames;
-use crate::ros::live::{imu_sample, tank_coordinates};
-use crate::ros::live_imu::LiveImu;
-use crate::ros::live_motion::{check_pose, Limits, Rejected};
+use crate::input::frames::Frames;
+use crate::input::live::{imu_sample, tank_coordinates};
+use crate::input::live_imu::LiveImu;
+use crate::input::live_motion::{check_pose, Limits, Rejected};
 use slosh_msgs::geometry_msgs::PoseStamped;
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::sensor_msgs::Imu;
@@ -310,11 +310,11 @@ fn schema_difference(schema: &str, ours: &str) -> Option<String> {
 struct Decoded {
     stamp_ns: i64,
     log_ns: u64,
-    reading: crate::ros::live::Reading,
+    reading: crate::input::live::Reading,
 }
 
 fn decode(bag: &Path, topic: &str, f: &Found, kind: Kind) -> Result<Vec<Decoded>, BagError> {
-    use crate::ros::live::Reading as R;
+    use crate::input::live::Reading as R;
     f.messages
         .iter()
         .enumerate()
@@ -360,7 +360,7 @@ fn build(
     decoded: Vec<Decoded>,
     how: &Reading,
 ) -> Result<BagMotion, String> {
-    use crate::ros::live::Reading as R;
+    use crate::input::live::Reading as R;
     let header = how.stamp == StampSource::Header && decoded.iter().any(|d| d.stamp_ns != 0);
     let time_ns = |d: &Decoded| {
         if header {

@@ -3,14 +3,7 @@
 
 pub mod args;
 pub mod cloud;
-pub mod convert;
-pub mod frames;
 pub mod graph_hint;
-pub mod gravity_check;
-pub mod live;
-pub mod live_imu;
-pub mod live_motion;
-pub mod live_state;
 pub mod motion_pub;
 pub mod node;
 pub mod pacing;
@@ -93,13 +86,4 @@ pub fn publish<M: serde::Serialize + std::fmt::Debug>(
         Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => Ok(()),
         Err(e) => Err(anyhow::anyhow!("publishing {what}: {e:?}")),
     }
-}
-
-/// SIGINT and SIGTERM set the returned flag, so loops can end cleanly (and files get finished).
-pub fn shutdown_flag() -> anyhow::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
-    let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        signal_hook::flag::register(sig, flag.clone())?;
-    }
-    Ok(flag)
 }

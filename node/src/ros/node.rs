@@ -3,41 +3,34 @@
 //! describe (the input's time base: output stamp = first input stamp + simulation time).
 
 use super::args::{Names, RosArgs};
-use super::convert::{quat_msg, vec3_msg};
-use super::frames::Frames;
-use super::gravity_check::{GravityCheck, InputKind};
-use super::live::{Live, Reading};
-use super::live_motion::Limits;
 use super::pacing::Pacing;
 use super::publish;
-use crate::config::{InputType, Loaded, RealtimeMode, StampSource};
+use crate::config::{InputType, Loaded, RealtimeMode, StampSource, DEFAULT_NAME};
+use crate::input::frames::Frames;
+use crate::input::gravity_check::{GravityCheck, InputKind};
+use crate::input::live::{Live, Reading};
+use crate::input::live_motion::Limits;
+use crate::messages::{body_topic, header, output_messages, static_transforms};
 use crate::record::{RawMessage, Recorder};
 use nalgebra::UnitQuaternion;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{NodeName, NodeOptions, Publisher, QosProfile, ServiceMapping, ServiceTypeName};
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
-use slosh_msgs::geometry_msgs::{
-    AccelStamped, Point, PoseStamped, Transform, TransformStamped, Wrench, WrenchStamped,
-};
+use slosh_msgs::geometry_msgs::{AccelStamped, PoseStamped, WrenchStamped};
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
 use slosh_msgs::sensor_msgs::{Imu, PointCloud2};
 use slosh_msgs::slosh_msgs::{PressureArray, ProbeArray};
-use slosh_msgs::std_msgs::Header;
 use slosh_msgs::std_srvs::{SetBoolRequest, SetBoolResponse, TriggerRequest, TriggerResponse};
 use slosh_msgs::tf2_msgs::TFMessage;
 use sph::motion::TankMotion as _;
-use sph::params::SimParams;
 use std::collections::VecDeque;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 /// Samples in a row on a new time base after which the node follows it (see the input loop).
 const NEW_TIME_BASE: usize = 10;
-
-/// The node's default name (`-r __node:=...` changes it).
-pub const DEFAULT_NAME: &str = "slosh";
 
 /// A warning repeated while a condition lasts (silence would look like a hang): first `first` s after the
 /// condition was first seen, then every 10 s.
@@ -100,139 +93,6 @@ fn qos_latched() -> QosProfile {
         .reliability_reliable(WhenFull::Wait(Duration::from_millis(50)))
         .durability(Durability::TransientLocal)
         .history(History::KeepLast { depth: 1 })
-}
-
-fn header(stamp: Time, frame: &str) -> Header {
-    Header {
-        stamp,
-        frame_id: frame.to_string(),
-    }
-}
-
-fn point(x: f64, y: f64, z: f64) -> Point {
-    Point { x, y, z }
-}
-
-/// Outputs of one observed state as messages.
-pub struct OutputMessages {
-    pub wrench: WrenchStamped,
-    pub probes: ProbeArray,
-    pub pressures: PressureArray,
-    /// Per floating body: its motion and the liquid's force on it.
-    pub bodies: Vec<BodyMessages>,
-}
-
-/// A floating body's outputs: `bodies/NAME/odom` (the pose of its centre of gravity in the tank frame, the
-/// twist in its own axes, as nav_msgs/Odometry has it) and `bodies/NAME/wrench` (the liquid's force and
-/// moment about the centre of gravity, tank axes).
-pub struct BodyMessages {
-    pub name: String,
-    pub odom: Odometry,
-    pub wrench: WrenchStamped,
-}
-
-/// The topic of a body's output `what` (`odom` or `wrench`) beside the tank's outputs.
-pub fn body_topic(name: &str, what: &str) -> String {
-    format!("bodies/{name}/{what}")
-}
-
-fn body_messages(tank_frame: &str, stamp: Time, b: &sph::body::BodyState) -> BodyMessages {
-    let q = b.quaternion;
-    let rot = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
-    let state = sph::motion::RigidState {
-        position: b.position.into(),
-        orientation: rot,
-        velocity: b.velocity.into(),
-        angular_velocity: rot.inverse_transform_vector(&b.angular_velocity.into()),
-        ..sph::motion::RigidState::at_rest()
-    };
-    BodyMessages {
-        name: b.name.clone(),
-        odom: super::motion_pub::odometry(&state, stamp, tank_frame, &b.name),
-        wrench: WrenchStamped {
-            header: header(stamp, tank_frame),
-            wrench: Wrench {
-                force: vec3_msg(b.force.into()),
-                torque: vec3_msg(b.moment.into()),
-            },
-        },
-    }
-}
-
-/// Builds the output messages of an observation at `stamp`.
-pub fn output_messages(
-    params: &SimParams,
-    tank_frame: &str,
-    stamp: Time,
-    o: &sph::observe::Observation,
-) -> OutputMessages {
-    OutputMessages {
-        wrench: WrenchStamped {
-            header: header(stamp, tank_frame),
-            wrench: Wrench {
-                force: vec3_msg(o.wrench.force.into()),
-                torque: vec3_msg(o.wrench.moment.into()),
-            },
-        },
-        probes: ProbeArray {
-            header: header(stamp, tank_frame),
-            names: params.probes.iter().map(|p| p.name.clone()).collect(),
-            positions: params.probes.iter().map(|p| point(p.x, p.y, 0.0)).collect(),
-            elevations: o.probes.clone(),
-        },
-        pressures: PressureArray {
-            header: header(stamp, tank_frame),
-            names: params
-                .pressure_sensors
-                .iter()
-                .map(|s| s.name.clone())
-                .collect(),
-            positions: params
-                .pressure_sensors
-                .iter()
-                .map(|s| point(s.x, s.y, s.z))
-                .collect(),
-            pressures: o.pressures.clone(),
-        },
-        bodies: o
-            .bodies
-            .iter()
-            .map(|b| body_messages(tank_frame, stamp, b))
-            .collect(),
-    }
-}
-
-/// The static transforms vessel → tank → each probe and sensor.
-fn static_transforms(cfg: &Loaded, params: &SimParams, stamp: Time) -> TFMessage {
-    let f = &cfg.config.frames;
-    let tp = f.tank_pose;
-    let q = UnitQuaternion::from_euler_angles(tp.roll, tp.pitch, tp.yaw);
-    let tf = |parent: &str, child: String, t: [f64; 3], q: UnitQuaternion<f64>| TransformStamped {
-        header: header(stamp, parent),
-        child_frame_id: child,
-        transform: Transform {
-            translation: vec3_msg(t.into()),
-            rotation: quat_msg(q),
-        },
-    };
-    let mut transforms = vec![tf(&f.vessel, f.tank.clone(), [tp.x, tp.y, tp.z], q)];
-    for p in &params.probes {
-        transforms.push(tf(
-            &f.tank,
-            format!("{}/probe/{}", f.tank, p.name),
-            [p.x, p.y, 0.0],
-            UnitQuaternion::identity(),
-        ));
-    }
-    for s in &params.pressure_sensors {
-        transforms.push(tf(
-            &f.tank,
-            format!("{}/pressure/{}", f.tank, s.name),
-            [s.x, s.y, s.z],
-            UnitQuaternion::identity(),
-        ));
-    }
-    TFMessage { transforms }
 }
 
 /// Counters reported in diagnostics.
@@ -391,11 +251,11 @@ impl Input {
                         let v = crate::iox::tank_state(&m, &identity);
                         raw.push(RawMessage::of(
                             topic,
-                            &super::motion_pub::odometry(&v, stamp, "odom", vessel),
+                            &crate::messages::motion::odometry(&v, stamp, "odom", vessel),
                         ));
                         raw.push(RawMessage::of(
                             accel_topic,
-                            &super::motion_pub::accel(&v, stamp, vessel),
+                            &crate::messages::motion::accel(&v, stamp, vessel),
                         ));
                     }
                     Some((stamp, raw, Reading::State(m)))
@@ -486,7 +346,7 @@ pub fn run(
         );
     }
     // Before the resolution trials, so that a signal during them stops the node cleanly too.
-    let stop = super::shutdown_flag()?;
+    let stop = crate::signals::shutdown_flag()?;
     let auto = &c.realtime.auto_resolution;
     let mut recorded_parameters = cfg.parameters.clone();
     let mut choice_record = None;
@@ -542,8 +402,8 @@ pub fn run(
     let iox = &c.iceoryx2;
     let iox_on = c.input.kind == InputType::Iceoryx2 || iox.outputs || iox.particles;
     if c.input.kind == InputType::Iceoryx2
-        && (c.input.world_frame != super::frames::WorldFrame::Enu
-            || c.input.body_frame != super::frames::BodyFrame::Flu)
+        && (c.input.world_frame != crate::config::WorldFrame::Enu
+            || c.input.body_frame != crate::config::BodyFrame::Flu)
     {
         anyhow::bail!(
             "{}: input.world_frame / input.body_frame: iceoryx2 motion samples are always in a z-up world and the FLU vessel frame; leave both at enu / flu",

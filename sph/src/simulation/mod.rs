@@ -1,4 +1,5 @@
-//! A liquid in a moving tank: the stage sequence of one step, readable top to bottom.
+//! A liquid in a moving tank: one [`State`] and the [`PressureScheme`] that advances it (each scheme's step
+//! reads top to bottom in its folder under [`crate::scheme`]), and the observables read from both.
 //!
 //! The liquid is integrated in the tank frame. The tank's motion enters only as the apparent gravity
 //! R^T (g − a) and the rotation terms (Euler, centrifugal, Coriolis), so the result does not depend on where

@@ -60,18 +60,18 @@ struct Lists<const D: usize> {
     /// read the neighbours from, then read them unchecked.
     end_j: usize,
     /// Per particle of the chunk: Σ_b m_b ∇W_ab over its wall neighbours (every wall term of the solver is
-    /// this sum times the particle's own k or velocity, and `wf`), the
+    /// this sum times the particle's own k or velocity, and `wall_flux`), the
     /// walls' moment about the tank origin per unit k, Σ_b x_b × (−MIRROR m_b ∇W_ab), and whether the
     /// particle has a full neighbourhood (not at the free surface).
-    gb: Vec<[f32; D]>,
-    mb: Vec<[f32; 3]>,
+    wall_grad: Vec<[f32; D]>,
+    wall_moment: Vec<[f32; 3]>,
     full: Vec<bool>,
     /// Per particle: the walls' part of the gradient correction's M, Σ_b V_b (x_b − x_a) ⊗ ∇W_ab
     /// (`gradient_correction`).
-    mw: Vec<Mat<D>>,
+    wall_shape: Vec<Mat<D>>,
     /// Per particle: Σ_b m_b v_b·∇W_ab, what moving walls (floating bodies, a wave maker) add to the rate of
     /// change of its density (0 beside walls at rest).
-    wf: Vec<f32>,
+    wall_flux: Vec<f32>,
 }
 
 /// What the passes over the chunks return, merged in chunk order.
@@ -155,7 +155,7 @@ struct Ctx<'a, const D: usize, K> {
 
 /// What one liquid particle's neighbourhood sums to (pass 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Hood<const D: usize> {
+struct Neighbourhood<const D: usize> {
     /// Summed density (the particle itself included).
     density: f32,
     /// Σ m∇W over liquid and over wall neighbours, Σ|m∇W|² over liquid neighbours.
@@ -169,7 +169,7 @@ struct Hood<const D: usize> {
     /// Σ_b x_b × (−MIRROR m_b ∇W_ab): the walls' pressure moment per unit k. (Every pair force acts along
     /// x_a − x_b, so Σ_b x_b × f_b = x_a × Σ_b f_b: the moments are the particle's position crossed with
     /// the summed forces, not sums over the pairs.)
-    mb: [f32; 3],
+    wall_moment: [f32; 3],
     /// Σ_b m_b v_b·∇W_ab.
     wflux: f32,
     /// Σ_b V_b (x_b − x_a) ⊗ ∇W_ab over the wall neighbours.
@@ -179,8 +179,8 @@ struct Hood<const D: usize> {
     walls: u32,
 }
 
-/// Per-lane partial sums of a [`Hood`].
-struct HoodLanes<const D: usize> {
+/// Per-lane partial sums of a [`Neighbourhood`].
+struct NeighbourhoodLanes<const D: usize> {
     density: [f32; LANES],
     grad: [[f32; LANES]; D],
     grad_b: [[f32; LANES]; D],
@@ -195,7 +195,7 @@ struct HoodLanes<const D: usize> {
 /// Where a particle's neighbours are: the rows of cells around it (ranges of the cell-sorted arrays) of the
 /// liquid and of the walls, and those arrays (positions, velocities).
 #[derive(Clone, Copy)]
-struct Around<'a, const D: usize> {
+struct Rows<'a, const D: usize> {
     liquid: &'a [(u32, u32)],
     walls: &'a [(u32, u32)],
     fluid: (&'a [Vec<f32>; D], &'a [Vec<f32>; D]),
@@ -208,20 +208,20 @@ struct Around<'a, const D: usize> {
 /// Branch-free over blocks of [`LANES`]: padding beyond the support adds nothing.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
+fn neighbourhood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
     k: &K,
     c: &Coefficients,
     (xa, va): ([f32; D], [f32; D]),
-    around: Around<'_, D>,
+    around: Rows<'_, D>,
     (fs, bs): (&mut Near<D>, &mut Near<D>),
     j: &mut Vec<u32>,
     g: &mut Vec<R>,
     wide: bool,
-) -> Hood<D> {
+) -> Neighbourhood<D> {
     fs.select(xa, c.pair.support2, around.liquid, around.fluid, wide);
     bs.select(xa, c.pair.support2, around.walls, around.bound, wide);
     let z = [0.0f32; LANES];
-    let mut s = HoodLanes {
+    let mut s = NeighbourhoodLanes {
         density: z,
         grad: [z; D],
         grad_b: [z; D],
@@ -242,11 +242,11 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
     g.reserve(fs.blocks() * LANES);
     let (js, gs) = (j.spare_capacity_mut(), g.spare_capacity_mut());
     let mut n = 0;
-    let (mf, mw) = (c.pair.m_fluid, c.pair.m_bound);
+    let (mf, wall_shape) = (c.pair.m_fluid, c.pair.m_bound);
     // Monaghan's Π_ab = −α c0 h min(v_ab·x_ab, 0) / ((r² + η²) ρ_rest): the constant factor of each.
     let visc = c.pair.alpha * c.pair.c0 * c.pair.h / c.rho_rest;
     let visc_b = c.pair.alpha_bound * c.pair.c0 * c.pair.h / c.rho_rest;
-    let vol_b = mw / c.rho_rest;
+    let vol_b = wall_shape / c.rho_rest;
     for blk in 0..fs.blocks() {
         let (dxs, ws, idx) = fs.block(blk);
         let mut gl = [z; D];
@@ -323,15 +323,15 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
             let fin = if r2 < c.pair.support2 { 1.0f32 } else { 0.0 };
             let r = r2.sqrt();
             let gf = k.grad_factor(r) * fin;
-            s.density[l] += mw * k.w(r) * fin;
+            s.density[l] += wall_shape * k.w(r) * fin;
             let pi = -visc_b * vr.min(0.0) / (r2 + c.pair.eta2);
             for d in 0..D {
                 let gd = gf * dx[d];
-                s.grad_b[d][l] += mw * gd;
-                s.wall[d][l] -= mw * pi * gd;
+                s.grad_b[d][l] += wall_shape * gd;
+                s.wall[d][l] -= wall_shape * pi * gd;
             }
             // m_b v_b·∇W_ab = m_b F(r) v_b·(x_a − x_b)
-            s.wflux[l] += mw * gf * ws[l];
+            s.wflux[l] += wall_shape * gf * ws[l];
             s.walls[l] += fin;
             // V_b (x_b − x_a) ⊗ ∇W_ab = −V_b F(r) dx ⊗ dx
             if c.corrected {
@@ -346,7 +346,7 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
     let wall: [f32; D] = std::array::from_fn(|d| lane_sum(&s.wall[d]));
     let grad_b: [f32; D] = std::array::from_fn(|d| lane_sum(&s.grad_b[d]));
     let push: [f32; D] = std::array::from_fn(|d| -MIRROR * grad_b[d]);
-    Hood {
+    Neighbourhood {
         density: lane_sum(&s.density),
         grad: std::array::from_fn(|d| lane_sum(&s.grad[d])),
         grad_b,
@@ -354,7 +354,7 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
         visc: std::array::from_fn(|d| lane_sum(&s.visc[d]) + wall[d]),
         wall,
         moment: cross(to3(xa), to3(wall)),
-        mb: cross(to3(xa), to3(push)),
+        wall_moment: cross(to3(xa), to3(push)),
         wflux: lane_sum(&s.wflux),
         shape_b: std::array::from_fn(|r| std::array::from_fn(|q| lane_sum(&s.shape_b[r][q]))),
         liquid: n as u32,
@@ -365,7 +365,7 @@ fn hood<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
 /// The lanes of one block of 3D neighbours set in `mask`, packed to the front (one lane permutation,
 /// `near::PACK`), as eight [`Half4`] records of the gradients times `scale` (x, y, z, 0) and eight
 /// indices, stored whole at `j` and `g` (what lies beyond the kept lanes is overwritten by the next block
-/// or cut off): the same bits in the same order as `hood`'s lane-by-lane writes (F16C rounds as
+/// or cut off): the same bits in the same order as `neighbourhood`'s lane-by-lane writes (F16C rounds as
 /// `half::to_half`), in ~30 instructions instead of ~150.
 ///
 /// # Safety
@@ -419,19 +419,19 @@ unsafe fn store_block_avx2(
     }
 }
 
-/// [`hood`] compiled for AVX2 + FMA (popcnt, F16C): the same source, its lane loops vectorised 8 wide.
+/// [`neighbourhood`] compiled for AVX2 + FMA (popcnt, F16C): the same source, its lane loops vectorised 8 wide.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,popcnt,f16c")]
-fn hood_avx2<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
+fn neighbourhood_avx2<const D: usize, const W: usize, R: Grad<D, W>, K: Kernel>(
     k: &K,
     c: &Coefficients,
     own: ([f32; D], [f32; D]),
-    around: Around<'_, D>,
+    around: Rows<'_, D>,
     near: (&mut Near<D>, &mut Near<D>),
     j: &mut Vec<u32>,
     g: &mut Vec<R>,
-) -> Hood<D> {
-    hood(k, c, own, around, near, j, g, true)
+) -> Neighbourhood<D> {
+    neighbourhood(k, c, own, around, near, j, g, true)
 }
 
 /// Pass 1 for one chunk: neighbour lists, density, factor and non-pressure acceleration.
@@ -452,11 +452,11 @@ fn build_chunk<const D: usize, K: Kernel>(
     lists.gh.clear();
     // Until the lists are whole again (a build cut short leaves no bound the passes would trust).
     lists.end_j = usize::MAX;
-    lists.gb.clear();
-    lists.wf.clear();
-    lists.mb.clear();
+    lists.wall_grad.clear();
+    lists.wall_flux.clear();
+    lists.wall_moment.clear();
     lists.full.clear();
-    lists.mw.clear();
+    lists.wall_shape.clear();
     // The cell whose rows of neighbouring cells are in `liquid` and `walls`.
     let mut cell = u32::MAX;
     for o in 0..rho.len() {
@@ -468,11 +468,11 @@ fn build_chunk<const D: usize, K: Kernel>(
             rho[o] = c.rho_rest;
             factor[o] = 0.0;
             acc[o] = [0.0; D];
-            lists.gb.push([0.0; D]);
-            lists.wf.push(0.0);
-            lists.mb.push([0.0; 3]);
+            lists.wall_grad.push([0.0; D]);
+            lists.wall_flux.push(0.0);
+            lists.wall_moment.push([0.0; 3]);
             lists.full.push(false);
-            lists.mw.push([[0.0; D]; D]);
+            lists.wall_shape.push([[0.0; D]; D]);
             continue;
         }
         if f.cell[a] != cell {
@@ -486,7 +486,7 @@ fn build_chunk<const D: usize, K: Kernel>(
         let xa: [f32; D] = std::array::from_fn(|d| f.x[d][a]);
         let va: [f32; D] = std::array::from_fn(|d| f.v[d][a]);
         let own = (xa, va);
-        let around = Around {
+        let around = Rows {
             liquid: &liquid[..nl],
             walls: &walls[..nw],
             fluid: (&f.x, &f.v),
@@ -498,23 +498,27 @@ fn build_chunk<const D: usize, K: Kernel>(
             // SAFETY: `wide` is true only where the CPU reports AVX2, FMA, popcnt and F16C.
             #[cfg(target_arch = "x86_64")]
             (true, true) => unsafe {
-                hood_avx2::<D, 4, Half4, K>(p.k, c, own, around, near, j, gh)
+                neighbourhood_avx2::<D, 4, Half4, K>(p.k, c, own, around, near, j, gh)
             },
             #[cfg(target_arch = "x86_64")]
-            (true, false) => unsafe { hood_avx2::<D, D, _, K>(p.k, c, own, around, near, j, g) },
+            (true, false) => unsafe {
+                neighbourhood_avx2::<D, D, _, K>(p.k, c, own, around, near, j, g)
+            },
             #[cfg(not(target_arch = "x86_64"))]
             (true, _) => unreachable!("wide lanes are x86_64 only"),
-            (false, true) => hood::<D, 4, Half4, K>(p.k, c, own, around, near, j, gh, false),
-            (false, false) => hood::<D, D, _, K>(p.k, c, own, around, near, j, g, false),
+            (false, true) => {
+                neighbourhood::<D, 4, Half4, K>(p.k, c, own, around, near, j, gh, false)
+            }
+            (false, false) => neighbourhood::<D, D, _, K>(p.k, c, own, around, near, j, g, false),
         };
         rho[o] = hd.density;
-        lists.gb.push(hd.grad_b);
-        lists.wf.push(hd.wflux);
-        lists.mb.push(hd.mb);
+        lists.wall_grad.push(hd.grad_b);
+        lists.wall_flux.push(hd.wflux);
+        lists.wall_moment.push(hd.wall_moment);
         lists
             .full
             .push(hd.liquid + hd.walls >= c.full_neighbourhood);
-        lists.mw.push(hd.shape_b);
+        lists.wall_shape.push(hd.shape_b);
         factor[o] = dfsph_factor(c, hd.grad, hd.grad_b, hd.sq);
         let fa: [f32; D] = from3(p.frame.acceleration(to3(xa), to3(va)));
         let mut a2 = 0.0f32;
@@ -564,7 +568,7 @@ fn dfsph_factor<const D: usize>(
 }
 
 /// Correction pass, first half, for one chunk: each particle's L (`gradient_correction`) from its liquid
-/// neighbours' records and positions and its walls' part `mw` (halo copies' are replaced by their owners'
+/// neighbours' records and positions and its walls' part `wall_shape` (halo copies' are replaced by their owners'
 /// afterwards).
 fn correction_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
     c: &Coefficients,
@@ -577,7 +581,7 @@ fn correction_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
     let unscale = 1.0 / R::scale(c.pair.h);
     for (o, l) in out.iter_mut().enumerate() {
         let a = first + o;
-        let mut m = lists.mw[o];
+        let mut m = lists.wall_shape[o];
         let (lo, hi) = (lists.start[o] as usize, lists.start[o + 1] as usize);
         for q in lo..hi {
             let b = lists.j[q] as usize;
@@ -622,13 +626,13 @@ fn corrected_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
                 sq += gd * gd;
             }
         }
-        let gb = correction::apply(la, lists.gb[o]);
-        lists.gb[o] = gb;
+        let wall_grad = correction::apply(la, lists.wall_grad[o]);
+        lists.wall_grad[o] = wall_grad;
         let xa: [f32; D] = std::array::from_fn(|d| x[d][a]);
-        let push: [f32; D] = std::array::from_fn(|d| -MIRROR * gb[d]);
-        lists.mb[o] = cross(to3(xa), to3(push));
+        let push: [f32; D] = std::array::from_fn(|d| -MIRROR * wall_grad[d]);
+        lists.wall_moment[o] = cross(to3(xa), to3(push));
         // (0 for halo copies and lone particles, which have no neighbours: as in the first pass.)
-        *f = dfsph_factor(c, grad, gb, sq);
+        *f = dfsph_factor(c, grad, wall_grad, sq);
     }
 }
 
@@ -672,11 +676,11 @@ fn error_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
             .iter()
             .take(D)
             .sum::<f32>();
-        let gb = lists.gb[o];
+        let wall_grad = lists.wall_grad[o];
         for d in 0..D {
-            s += va[d] * gb[d];
+            s += va[d] * wall_grad[d];
         }
-        s -= lists.wf[o];
+        s -= lists.wall_flux[o];
         let (e, kk) = match mode {
             Mode::Density => {
                 let e = (rho[o] + dt * s - c.rho_rest).max(0.0);
@@ -725,9 +729,9 @@ fn update_chunk<const D: usize, const W: usize, R: Grad<D, W>>(
         // SAFETY: every index in the lists is below `end_j` (asserted above); `wide` only with AVX, as in
         // `error_chunk`.
         let acc = unsafe { R::push(&lists.j[lo..hi], &g[lo..hi], kall, ka, wide) };
-        let gb = lists.gb[o];
+        let wall_grad = lists.wall_grad[o];
         for d in 0..D {
-            vel[o][d] -= dt * (m * acc[d] + MIRROR * ka * gb[d]);
+            vel[o][d] -= dt * (m * acc[d] + MIRROR * ka * wall_grad[d]);
         }
         if let Some(p) = vel4.get_mut(o) {
             *p = std::array::from_fn(|d| if d < D { vel[o][d] } else { 0.0 });
@@ -794,11 +798,11 @@ fn wall_chunk<const D: usize>(c: &Coefficients, lists: &Lists<D>, ksum: &[f32]) 
     let mut tot = PassTotals::default();
     for (o, k) in ksum.iter().enumerate() {
         let f = to3(std::array::from_fn::<f32, D, _>(|d| {
-            -MIRROR * k * lists.gb[o][d]
+            -MIRROR * k * lists.wall_grad[o][d]
         }));
         for d in 0..3 {
             tot.force[d] += (f[d] * c.pair.m_fluid) as f64;
-            tot.moment[d] += (k * lists.mb[o][d] * c.pair.m_fluid) as f64;
+            tot.moment[d] += (k * lists.wall_moment[o][d] * c.pair.m_fluid) as f64;
         }
     }
     Partial {
@@ -917,7 +921,7 @@ impl<const D: usize> Workspace<D> {
         share_room(near);
         // The same for the neighbour lists, more tightly (they are most of the solver's memory): room for
         // the longest list any chunk has held plus a quarter, plus one particle's candidates (more than
-        // what `hood` reserves beyond the end), once a chunk's falls below the longest plus a sixteenth.
+        // what `neighbourhood` reserves beyond the end), once a chunk's falls below the longest plus a sixteenth.
         let peak = lists.iter().map(|l| l.j.len()).max().unwrap_or(0);
         let cands = near.iter().map(|c| c.0.peak()).max().unwrap_or(0);
         for l in lists.iter_mut() {
@@ -1309,12 +1313,12 @@ mod tests {
     ) {
         let xa: [f64; D] = std::array::from_fn(|d| x[d][a] as f64);
         let va: [f64; D] = std::array::from_fn(|d| v[d][a] as f64);
-        let (mf, mw) = (c.pair.m_fluid as f64, c.pair.m_bound as f64);
+        let (mf, wall_shape) = (c.pair.m_fluid as f64, c.pair.m_bound as f64);
         let mut density = mf * k.w(0.0) as f64;
         let (mut grad, mut grad_b, mut sq, mut visc) = ([0.0; D], [0.0; D], 0.0, [0.0; D]);
         let mut list = Vec::new();
         let mut wflux = 0.0;
-        let (mut wall_visc, mut moment, mut mb) = ([0.0; D], [0.0f64; 3], [0.0f64; 3]);
+        let (mut wall_visc, mut moment, mut wall_moment) = ([0.0; D], [0.0f64; 3], [0.0f64; 3]);
         for (wall, xs, n) in [(false, x, x[0].len()), (true, xb, xb[0].len())] {
             for j in 0..n {
                 if !wall && j == a {
@@ -1336,7 +1340,7 @@ mod tests {
                 let r = r2.sqrt();
                 let gf = k.grad_factor(r as f32) as f64;
                 let (m, alpha) = if wall {
-                    (mw, c.pair.alpha_bound as f64)
+                    (wall_shape, c.pair.alpha_bound as f64)
                 } else {
                     (mf, c.pair.alpha as f64)
                 };
@@ -1370,7 +1374,7 @@ mod tests {
                     };
                     for e in 0..3 {
                         moment[e] += cross(xw, f)[e];
-                        mb[e] += cross(xw, fk)[e];
+                        wall_moment[e] += cross(xw, fk)[e];
                     }
                     for d in 0..D {
                         wall_visc[d] += fd[d];
@@ -1382,11 +1386,11 @@ mod tests {
         }
         (
             (density, grad, grad_b, sq, visc, list, wflux),
-            (wall_visc, moment, mb),
+            (wall_visc, moment, wall_moment),
         )
     }
 
-    /// [`hood`] (AVX2 lanes where `wide`) with gradient records R of W lanes: its sums, its neighbour
+    /// [`neighbourhood`] (AVX2 lanes where `wide`) with gradient records R of W lanes: its sums, its neighbour
     /// list, the sum of the listed gradients (whose lanes beyond D must be 0) and of their magnitudes
     /// (unscaled), and the records' bits.
     #[allow(clippy::type_complexity)]
@@ -1394,9 +1398,9 @@ mod tests {
         k: &K,
         c: &Coefficients,
         own: ([f32; D], [f32; D]),
-        around: Around<'_, D>,
+        around: Rows<'_, D>,
         wide: bool,
-    ) -> (Hood<D>, Vec<u32>, [(f64, f64); D], Vec<u32>) {
+    ) -> (Neighbourhood<D>, Vec<u32>, [(f64, f64); D], Vec<u32>) {
         let (mut j, mut g) = (Vec::new(), Vec::<R>::new());
         let (mut fs, mut bs) = (Near::default(), Near::default());
         let near = (&mut fs, &mut bs);
@@ -1404,12 +1408,12 @@ mod tests {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: only where `wide_lanes()` holds.
             unsafe {
-                hood_avx2(k, c, own, around, near, &mut j, &mut g)
+                neighbourhood_avx2(k, c, own, around, near, &mut j, &mut g)
             }
             #[cfg(not(target_arch = "x86_64"))]
             unreachable!()
         } else {
-            hood(k, c, own, around, near, &mut j, &mut g, false)
+            neighbourhood(k, c, own, around, near, &mut j, &mut g, false)
         };
         assert_eq!(g.len(), j.len());
         let g: Vec<[f32; W]> = g.into_iter().map(R::lanes).collect();
@@ -1485,7 +1489,7 @@ mod tests {
         let n = x[0].len() as u32;
         let liquid = [(0, n / 3), (n / 3, 2 * n / 3), (2 * n / 3, n)];
         let walls = [(0, xb[0].len() as u32)];
-        let around = Around {
+        let around = Rows {
             liquid: &liquid,
             walls: &walls,
             fluid: (&x, &v),
@@ -1495,7 +1499,7 @@ mod tests {
         let n = x[0].len();
         let mut viscous_walls = false;
         for a in [n / 2, n1 / 2] {
-            let ((density, grad, grad_b, sq, visc, list, wflux), (wall, moment, mb)) =
+            let ((density, grad, grad_b, sq, visc, list, wflux), (wall, moment, wall_moment)) =
                 naive(&k, &c, a, (&x, &v), (&xb, &vb));
             let own = (
                 std::array::from_fn(|d| x[d][a]),
@@ -1558,7 +1562,7 @@ mod tests {
                         "moment {e}"
                     );
                     assert!(
-                        (s.mb[e] as f64 - mb[e]).abs() < 1e-4 * gs * arm,
+                        (s.wall_moment[e] as f64 - wall_moment[e]).abs() < 1e-4 * gs * arm,
                         "moment per unit k {e}"
                     );
                 }
@@ -1586,7 +1590,10 @@ mod tests {
             );
             assert!(grad_b.iter().any(|q| q.abs() > 0.0), "walls in reach");
             assert!(wflux.abs() > 0.0, "moving walls in reach");
-            assert!(mb.iter().any(|q| q.abs() > 0.0), "wall moments to compare");
+            assert!(
+                wall_moment.iter().any(|q| q.abs() > 0.0),
+                "wall moments to compare"
+            );
             viscous_walls |= wall.iter().any(|q| q.abs() > 1e-3 * vs);
         }
         assert!(viscous_walls, "approaching walls to compare");

@@ -2,6 +2,13 @@
 //! parsed once into typed structs. `--set key.sub=value` overrides any parameter by its dotted name, the value
 //! parsed as YAML. Every error names the file, the parameter and what is accepted.
 
+mod features;
+
+pub use features::{
+    AutoResolutionCfg, BadSamples, BodyFrame, ChosenBy, RecordCfg, ReplayCfg, TankPose, WorldFrame,
+    DEFAULT_NAME,
+};
+
 use serde::Deserialize;
 use serde_json::{Map, Value};
 use sph::motion::{JonswapDof, RegularDof};
@@ -13,51 +20,51 @@ use std::path::{Path, PathBuf};
 pub const BUILTIN: &[(&str, &str)] = &[
     (
         "seed_tank_039",
-        include_str!("../launch-configs/seed_tank_039.yaml"),
+        include_str!("../../launch-configs/seed_tank_039.yaml"),
     ),
     (
         "seed_tank_019",
-        include_str!("../launch-configs/seed_tank_019.yaml"),
+        include_str!("../../launch-configs/seed_tank_019.yaml"),
     ),
     (
         "dambreak_2d",
-        include_str!("../launch-configs/dambreak_2d.yaml"),
+        include_str!("../../launch-configs/dambreak_2d.yaml"),
     ),
     (
         "faltinsen2000_sway",
-        include_str!("../launch-configs/faltinsen2000_sway.yaml"),
+        include_str!("../../launch-configs/faltinsen2000_sway.yaml"),
     ),
     (
         "spheric10",
-        include_str!("../launch-configs/spheric10.yaml"),
+        include_str!("../../launch-configs/spheric10.yaml"),
     ),
     (
         "akyildiz2006_pitch",
-        include_str!("../launch-configs/akyildiz2006_pitch.yaml"),
+        include_str!("../../launch-configs/akyildiz2006_pitch.yaml"),
     ),
     (
         "bouscasse2013_shallow",
-        include_str!("../launch-configs/bouscasse2013_shallow.yaml"),
+        include_str!("../../launch-configs/bouscasse2013_shallow.yaml"),
     ),
     (
         "kleefsman2005_dambreak",
-        include_str!("../launch-configs/kleefsman2005_dambreak.yaml"),
+        include_str!("../../launch-configs/kleefsman2005_dambreak.yaml"),
     ),
     (
         "flooding_case_a",
-        include_str!("../launch-configs/flooding_case_a.yaml"),
+        include_str!("../../launch-configs/flooding_case_a.yaml"),
     ),
     (
         "flooding_case_b",
-        include_str!("../launch-configs/flooding_case_b.yaml"),
+        include_str!("../../launch-configs/flooding_case_b.yaml"),
     ),
     (
         "flooding_case_c",
-        include_str!("../launch-configs/flooding_case_c.yaml"),
+        include_str!("../../launch-configs/flooding_case_c.yaml"),
     ),
     (
         "flooding_3d_compartment",
-        include_str!("../launch-configs/flooding_3d_compartment.yaml"),
+        include_str!("../../launch-configs/flooding_3d_compartment.yaml"),
     ),
 ];
 
@@ -322,10 +329,10 @@ pub struct RunConfig {
     pub service_mapping: ServiceMappingCfg,
     /// Recording to a rosbag2 MCAP folder (`record.path`; empty: off).
     #[serde(default)]
-    pub record: crate::record::RecordCfg,
+    pub record: RecordCfg,
     /// How `slosh replay` treats bad samples in a bag.
     #[serde(default)]
-    pub replay: crate::replay::ReplayCfg,
+    pub replay: ReplayCfg,
     /// The `particles` PointCloud2 output of `slosh node` (off by default).
     #[serde(default)]
     pub particles: ParticlesCfg,
@@ -427,8 +434,8 @@ pub enum InputType {
 pub struct InputCfg {
     #[serde(rename = "type")]
     pub kind: InputType,
-    pub world_frame: crate::ros::frames::WorldFrame,
-    pub body_frame: crate::ros::frames::BodyFrame,
+    pub world_frame: WorldFrame,
+    pub body_frame: BodyFrame,
     /// The solver stays this many sample intervals behind the newest sample (0 = right up to it).
     pub delay_samples: usize,
     /// m/s: a sample implying a faster move than this from the previous one is rejected as a jump.
@@ -477,7 +484,7 @@ pub enum StampSource {
 pub struct FramesCfg {
     pub vessel: String,
     pub tank: String,
-    pub tank_pose: crate::ros::frames::TankPose,
+    pub tank_pose: TankPose,
 }
 
 impl Default for FramesCfg {
@@ -509,7 +516,7 @@ pub enum RealtimeMode {
 pub struct RealtimeCfg {
     pub mode: RealtimeMode,
     /// Choose `particle_spacing` at start-up from a timed trial so that `realtime` mode keeps up.
-    pub auto_resolution: crate::resolution::AutoResolutionCfg,
+    pub auto_resolution: AutoResolutionCfg,
 }
 
 /// A loaded configuration: the typed parameters, where they came from, and the merged parameter tree.
@@ -676,7 +683,7 @@ pub fn from_str(
     let chosen = if sections.len() == 1 {
         sections
     } else {
-        let fqn = format!("/{}", crate::ros::node::DEFAULT_NAME);
+        let fqn = format!("/{}", DEFAULT_NAME);
         let (mine, others): (Vec<_>, Vec<_>) = sections
             .into_iter()
             .partition(|s| crate::param_file::applies(&s.name, &fqn));
@@ -688,7 +695,7 @@ pub fn from_str(
                     "several node sections ({}) and none for {fqn}: a file with several is read as the node \
                      {fqn} reads it (its sections `{}:`, `/**:`, ...); `slosh node` reads those for its own name",
                     names.join(", "),
-                    crate::ros::node::DEFAULT_NAME,
+                    DEFAULT_NAME,
                 ),
             });
         }

@@ -3,7 +3,7 @@
 //! ([`CoupledMotion`]), so the solver may go right up to the newest sample: nothing is estimated from
 //! later ones.
 //!
-//! [`MotionSample`]: crate::iox::MotionSample
+//! [`MotionSample`]: slosh_msgs::iox::MotionSample
 
 use super::live_motion::{Limits, Rejected};
 use sph::motion::{CoupledMotion, RigidState, TankMotion};

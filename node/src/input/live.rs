@@ -2,11 +2,11 @@
 //! spline, or IMU readings. Converts from the configured frame conventions and gives the solver a
 //! [`TankMotion`] that never extends past what was received.
 
-use super::convert::{position, unit, vector};
 use super::frames::Frames;
 use super::live_imu::{ImuSample, LiveImu};
 use super::live_motion::{Limits, LiveMotion, Rejected};
 use super::live_state::LiveState;
+use crate::messages::convert::{position, unit, vector};
 use nalgebra::{UnitQuaternion, Vector3};
 use slosh_msgs::geometry_msgs::{Pose, Quaternion as QuatMsg, Vector3 as Vec3Msg};
 use slosh_msgs::sensor_msgs::Imu;
@@ -18,7 +18,7 @@ pub enum Reading {
     Pose(Pose),
     Imu(Box<Imu>),
     /// The vessel's full state from iceoryx2 (z-up world, FLU vessel frame).
-    State(crate::iox::MotionSample),
+    State(slosh_msgs::iox::MotionSample),
 }
 
 /// The tank's six coordinates (x, y, z, roll, pitch, yaw) from a received vessel pose.
@@ -69,7 +69,7 @@ fn orientation(q: &QuatMsg) -> Result<(), Rejected> {
 pub enum Live {
     Pose(LiveMotion, Accel),
     Imu(LiveImu),
-    State(LiveState, crate::iox::Mount),
+    State(LiveState, super::sample::Mount),
 }
 
 /// Measured accelerations of the vessel (geometry_msgs/AccelStamped on `motion/accel`, body frame), used
@@ -109,13 +109,13 @@ impl Accel {
 }
 
 impl Live {
-    /// Empty input of full states (iceoryx2 [`crate::iox::MotionSample`]s) for a tank mounted as `frames`
+    /// Empty input of full states (iceoryx2 [`slosh_msgs::iox::MotionSample`]s) for a tank mounted as `frames`
     /// says.
     pub fn states(limits: Limits, frames: &Frames) -> Self {
         let (offset, rotation) = frames.mount();
         Live::State(
             LiveState::new(limits),
-            crate::iox::Mount { offset, rotation },
+            super::sample::Mount { offset, rotation },
         )
     }
 
@@ -172,8 +172,8 @@ impl Live {
             (Live::Pose(m, _), Reading::Pose(p)) => m.push(t, tank_coordinates(p, frames)?),
             (Live::Imu(m), Reading::Imu(i)) => m.push(t, imu_sample(i, frames)?),
             (Live::State(m, mount), Reading::State(s)) => {
-                crate::iox::check(s).map_err(Rejected::Invalid)?;
-                m.push(t, crate::iox::tank_state(s, mount))
+                super::sample::check(s).map_err(Rejected::Invalid)?;
+                m.push(t, super::sample::tank_state(s, mount))
             }
             _ => unreachable!("the input's kind is fixed at start-up"),
         }
@@ -236,8 +236,8 @@ impl TankMotion for Live {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ros::convert::{point_msg, quat_msg, vec3_msg};
-    use crate::ros::frames::{BodyFrame, TankPose, WorldFrame};
+    use crate::config::{BodyFrame, TankPose, WorldFrame};
+    use crate::messages::convert::{point_msg, quat_msg, vec3_msg};
     use sph::motion::{Dof6Motion, RegularDof, RegularMotion};
 
     #[test]

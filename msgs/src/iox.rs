@@ -1,4 +1,4 @@
-//! The fixed-layout (`#[repr(C)]`, no heap) payloads of the iceoryx2 services. Their `type_name`s are what a
+//! The fixed-layout (`#[repr(C)]`, no heap) payloads of slosh's iceoryx2 services (feature `iceoryx2`). Their `type_name`s are what a
 //! peer in another language declares to open the same services. Units are SI; frames as named per field.
 
 use iceoryx2::prelude::ZeroCopySend;
@@ -54,7 +54,9 @@ pub struct StepOutputs {
     pub probes: [f64; MAX_SENSORS],
     /// Gauge pressure at each sensor, Pa; `pressure_count` used.
     pub pressures: [f64; MAX_SENSORS],
+    /// Probes in `probes`.
     pub probe_count: u32,
+    /// Sensors in `pressures`.
     pub pressure_count: u32,
     /// [`STATUS_OK`], [`STATUS_REJECTED`] or [`STATUS_FAILED`].
     pub status: u32,
@@ -102,10 +104,12 @@ impl StepOutputs {
         self.message[..end].copy_from_slice(&text.as_bytes()[..end]);
     }
 
+    /// The probes' elevations carried.
     pub fn probes(&self) -> &[f64] {
         &self.probes[..self.probe_count as usize]
     }
 
+    /// The sensors' pressures carried.
     pub fn pressures(&self) -> &[f64] {
         &self.pressures[..self.pressure_count as usize]
     }
@@ -122,6 +126,7 @@ pub struct ParticleHeader {
     pub fluid: u64,
     /// 2 or 3 (a 2D run has y = 0).
     pub dimension: u32,
+    /// Padding to eight bytes (0).
     pub reserved: u32,
 }
 

@@ -2,44 +2,8 @@
 //! z up (FLU, REP 103); vessels from marine pipelines often come in NED / FRD (x forward, y right, z down).
 //! The tank's pose in the vessel frame turns the vessel's pose into the tank's.
 
+use crate::config::{BodyFrame, TankPose, WorldFrame};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
-use serde::Deserialize;
-
-/// World frame of incoming poses.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum WorldFrame {
-    /// x east, y north, z up (REP 103).
-    #[default]
-    Enu,
-    /// x north, y east, z down.
-    Ned,
-}
-
-/// Body frame of incoming poses.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum BodyFrame {
-    /// x forward, y left, z up (REP 103).
-    #[default]
-    Flu,
-    /// x forward, y right, z down.
-    Frd,
-}
-
-/// Pose of the tank frame (origin at the centre of the tank bottom) in the vessel's FLU body frame.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct TankPose {
-    /// m.
-    pub x: f64,
-    pub y: f64,
-    pub z: f64,
-    /// rad, intrinsic z-y'-x'' (yaw, then pitch, then roll).
-    pub roll: f64,
-    pub pitch: f64,
-    pub yaw: f64,
-}
 
 /// Turns vessel poses in the configured conventions into tank poses in the z-up world.
 #[derive(Debug, Clone, Copy)]
