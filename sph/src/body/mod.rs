@@ -1,7 +1,7 @@
 //! Floating bodies: rigid hollow boxes of dynamic boundary particles that the liquid moves (the paper's
 //! damaged box, its cases 2 and 3). Their particles sit among the tank's wall particles (tagged with their
 //! body particle index) and act on the liquid as walls do; the liquid's reaction on them is summed into a
-//! force and moment on each body ([`coupling`]) and integrated with its mass and inertia ([`rigid`]).
+//! force and moment on each body ([`crate::scheme::coupling`]) and integrated with its mass and inertia ([`rigid`]).
 
 pub mod piston;
 pub mod rigid;
