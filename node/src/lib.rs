@@ -6,6 +6,7 @@
 
 pub mod bag;
 pub mod bench;
+pub mod cli;
 pub mod config;
 pub mod input;
 pub mod iox;
