@@ -4,6 +4,7 @@
 // to catch NaN along with negatives.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod accuracy;
 pub mod bag;
 pub mod bench;
 pub mod cli;

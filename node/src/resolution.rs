@@ -1,7 +1,9 @@
 //! Automatic resolution for real time: times a short trial of the case at candidate particle spacings, from
 //! the coarsest up, and keeps the finest whose measured real-time factor has the requested margin. The trial
 //! runs the config's own `motion.*` (so it should resemble the motion expected live: a tank at rest steps
-//! faster than a sloshing one).
+//! faster than a sloshing one). The candidates go no coarser than the coarsest spacing the manual's
+//! convergence table measures accurate for the case's scheme ([`crate::accuracy`]) unless
+//! `allow_inaccurate` is set: speed does not come from silently giving up accuracy.
 
 use crate::config::AutoResolutionCfg;
 use crate::config::Loaded;
@@ -21,6 +23,11 @@ pub struct Choice {
     pub target_factor: f64,
     /// Candidate spacings left out because the case is not valid at them (spacing, why), coarsest first.
     pub skipped: Vec<(f64, String)>,
+    /// Why spacings up to `max_spacing` were not all tried: the coarsest accurate spacing held them back.
+    pub held_by_accuracy: Option<String>,
+    /// With `allow_inaccurate`, a spacing chosen coarser than the accurate ones: what the convergence table
+    /// measures nearest to it.
+    pub accuracy_warning: Option<String>,
 }
 
 impl Choice {
@@ -31,8 +38,13 @@ impl Choice {
             .iter()
             .map(|(dp, f)| format!("{:.4} m: {f:.2}", dp))
             .collect();
+        let accuracy = match (&self.held_by_accuracy, &self.accuracy_warning) {
+            (Some(_), _) => "; coarser spacings not tried: not accurate (convergence table)",
+            (_, Some(_)) => "; coarser than the accurate spacings (convergence table)",
+            _ => "",
+        };
         format!(
-            "dp {:.4} m, trial real-time factor {:.2}{} (target {:.2}; tried {})",
+            "dp {:.4} m, trial real-time factor {:.2}{} (target {:.2}; tried {}){accuracy}",
             self.particle_spacing,
             self.realtime_factor,
             if self.met {
@@ -100,10 +112,33 @@ pub fn choose(
 ) -> anyhow::Result<Option<Choice>> {
     let base: SimParams = cfg.sim_params()?;
     auto.check(cfg)?;
-    let coarsest = if auto.max_spacing > 0.0 {
+    let asked = if auto.max_spacing > 0.0 {
         auto.max_spacing
     } else {
         4.0 * base.particle_spacing
+    };
+    let (fill, finest) = (base.fill.height, base.particle_spacing);
+    let accuracy = crate::accuracy::Accuracy::for_case(&base);
+    let accurate = accuracy.coarsest_spacing(fill);
+    let what = format!(
+        "{} in {}D",
+        crate::accuracy::setting_of(&base),
+        base.dimension
+    );
+    let floor = accurate.unwrap_or(finest).max(finest);
+    let (coarsest, held_by_accuracy) = if auto.allow_inaccurate || floor >= asked * (1.0 - 1e-9) {
+        (asked, None)
+    } else {
+        let why = match (accurate, accuracy.per_depth) {
+            (Some(_), Some(n)) => format!(
+                "spacings coarser than {floor:.4} m not tried: the manual's convergence table measures the first sloshing mode's period within 1 % and a damping ratio of at most 0.005 with {what} only from {n:.0} particles per depth ({:.4} m for this {fill} m fill); realtime.auto_resolution.allow_inaccurate: true tries them",
+                fill / n
+            ),
+            _ => format!(
+                "no spacing coarser than particle_spacing ({finest} m) tried: the manual's convergence table measures no spacing of {what} with the first sloshing mode's period within 1 % and a damping ratio of at most 0.005; realtime.auto_resolution.allow_inaccurate: true tries coarser ones"
+            ),
+        };
+        (floor, Some(why))
     };
     let motion = crate::motion_source::build(cfg)?;
     let mut trials = vec![];
@@ -148,6 +183,16 @@ pub fn choose(
         Some((dp, rtf)) => (dp, rtf, true),
         None => (coarse_dp, coarse_rtf, false),
     };
+    let accuracy_warning = (particle_spacing > floor * (1.0 + 1e-9))
+        .then(|| accuracy.nearest(fill, particle_spacing))
+        .flatten()
+        .map(|m| {
+            format!(
+                "dp {particle_spacing:.4} m ({:.0} particles per depth) is coarser than the spacings the manual's convergence table measures accurate with {what}; nearest to it the table measures the first sloshing mode's {}: expect errors of that size",
+                fill / particle_spacing,
+                m.describe()
+            )
+        });
     Ok(Some(Choice {
         particle_spacing,
         realtime_factor,
@@ -155,6 +200,8 @@ pub fn choose(
         met,
         target_factor: auto.target_factor,
         skipped,
+        held_by_accuracy,
+        accuracy_warning,
     }))
 }
 
@@ -180,6 +227,7 @@ mod tests {
             max_spacing: 0.04,
             trial_s: 0.1,
             target_factor: 1.0,
+            allow_inaccurate: true,
         };
         let c = choose(&cfg, &auto, &AtomicBool::new(false))
             .unwrap()
@@ -208,6 +256,75 @@ mod tests {
         assert!(!c.skipped.is_empty() && c.skipped.iter().all(|(dp, _)| *dp > c.trials[0].0));
         // A signal before (or during) the trials ends them with no choice.
         assert_eq!(choose(&cfg, &auto, &AtomicBool::new(true)).unwrap(), None);
+        // Coarser than the convergence table's accurate spacings (the shipped incompressible scheme has
+        // none), the choice says what the table measures there.
+        let c = choose(&cfg, &auto, &AtomicBool::new(false))
+            .unwrap()
+            .unwrap();
+        assert_eq!(c.held_by_accuracy, None);
+        if c.particle_spacing > 0.01 {
+            let w = c.accuracy_warning.as_deref().expect("a warning");
+            assert!(w.contains("period") && w.contains("damping ratio"), "{w}");
+        }
+    }
+
+    /// By default the trials go no coarser than the coarsest spacing the convergence table measures
+    /// accurate for the case's scheme, and say so.
+    #[test]
+    fn the_trials_keep_to_accurate_spacings_unless_told_otherwise() {
+        let case = |extra: &str| {
+            let text = format!("slosh:\n  ros__parameters:\n    dimension: 2\n    tank: {{length: 0.8, breadth: 0.25, height: 0.6}}\n    fill_height: 0.19\n    particle_spacing: 0.005\n    solver: {{scheme: dfsph{extra}}}\n");
+            crate::config::from_str(&text, "test", None, &[]).unwrap()
+        };
+        let auto = AutoResolutionCfg {
+            enabled: true,
+            max_spacing: 0.02,
+            trial_s: 0.02,
+            target_factor: 1e-6,
+            allow_inaccurate: false,
+        };
+        let never = AtomicBool::new(false);
+        // The shipped settings: no spacing passes, so only particle_spacing is tried.
+        let c = choose(&case(""), &auto, &never).unwrap().unwrap();
+        assert_eq!(c.trials.len(), 1);
+        assert_eq!(c.particle_spacing, 0.005);
+        let why = c.held_by_accuracy.as_deref().expect("a reason");
+        assert!(
+            why.contains("no spacing coarser than particle_spacing")
+                && why.contains("allow_inaccurate"),
+            "{why}"
+        );
+        assert!(c.describe().contains("not accurate"), "{}", c.describe());
+        // Corrected gradients, Wendland kernel, no artificial viscosity: accurate from about 24 particles per
+        // depth, so the trials stop at the candidate spacings up to 0.19 m / 24.
+        let corrected = case(
+            ", kernel: wendland, artificial_viscosity: {alpha: 0.0}, dfsph: {kernel_correction: true}",
+        );
+        let c = choose(&corrected, &auto, &never).unwrap().unwrap();
+        let floor = crate::accuracy::Accuracy::for_case(&corrected.sim_params().unwrap())
+            .coarsest_spacing(0.19)
+            .unwrap();
+        assert!(c.trials.len() >= 2, "{c:?}");
+        assert!(
+            c.trials.iter().all(|t| t.0 <= floor * (1.0 + 1e-9)),
+            "{c:?}"
+        );
+        assert!(c.held_by_accuracy.is_some() && c.accuracy_warning.is_none());
+        // Allowed to, they start at max_spacing, and a coarse choice carries the table's figures.
+        // (A target no trial meets: the coarsest is chosen.)
+        let loose = AutoResolutionCfg {
+            allow_inaccurate: true,
+            target_factor: 1e6,
+            ..auto
+        };
+        let c = choose(&case(""), &loose, &never).unwrap().unwrap();
+        assert_eq!(c.particle_spacing, c.trials[0].0);
+        assert!(c.particle_spacing > 0.015, "{c:?}");
+        let w = c.accuracy_warning.as_deref().expect("a warning");
+        assert!(
+            w.contains("particles per depth") && w.contains("expect errors"),
+            "{w}"
+        );
     }
 
     #[test]

@@ -1335,11 +1335,20 @@ fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
             && how.contains("(target 1.20;"),
         "{how}"
     );
+    // The shipped incompressible settings have no spacing the convergence table measures accurate: the trials
+    // keep to particle_spacing, and say why.
+    assert_eq!(dp, 0.01, "{how}");
+    assert!(how.contains("coarser spacings not tried: not accurate"), "{how}");
     assert_eq!(get("scheme"), "dfsph");
     // The bag's parameters record (read by the mcap reader) gives the spacing run, not the one asked for,
     // and how it was chosen.
     let log = stop_logged_in(&mut proc.0);
     assert!(log.contains("(target real-time factor 1.2)"), "{log}");
+    assert!(
+        log.contains("no spacing coarser than particle_spacing (0.01 m) tried")
+            && log.contains("allow_inaccurate"),
+        "{log}"
+    );
     let meta = &common::read_bag(&bag)["metadata"]["slosh_parameters"];
     let params: serde_json::Value =
         serde_json::from_str(meta["parameters"].as_str().unwrap()).unwrap();

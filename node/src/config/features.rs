@@ -97,6 +97,10 @@ pub struct AutoResolutionCfg {
     pub trial_s: f64,
     /// Real-time factor a spacing must reach in its trial to be chosen.
     pub target_factor: f64,
+    /// Let the trials go coarser than the coarsest spacing the manual's convergence table measures accurate
+    /// for the case's scheme (first sloshing mode within 1 % of its period, damping ratio at most 0.005;
+    /// `crate::accuracy`); the node then warns with the errors the table measures near the spacing chosen.
+    pub allow_inaccurate: bool,
 }
 
 impl Default for AutoResolutionCfg {
@@ -106,6 +110,7 @@ impl Default for AutoResolutionCfg {
             max_spacing: 0.0,
             trial_s: 0.3,
             target_factor: 1.25,
+            allow_inaccurate: false,
         }
     }
 }

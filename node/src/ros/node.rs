@@ -375,6 +375,12 @@ pub fn run(
                 names.node
             );
         }
+        if let Some(why) = &choice.held_by_accuracy {
+            eprintln!("[{}] realtime.auto_resolution: {why}", names.node);
+        }
+        if let Some(w) = &choice.accuracy_warning {
+            eprintln!("[{}] warning: realtime.auto_resolution: {w}", names.node);
+        }
         params.particle_spacing = choice.particle_spacing;
         // The recording documents the spacing run, and how it was chosen.
         recorded_parameters["particle_spacing"] = serde_json::json!(choice.particle_spacing);
