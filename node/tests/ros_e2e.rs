@@ -1338,7 +1338,10 @@ fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
     // The shipped incompressible settings have no spacing the convergence table measures accurate: the trials
     // keep to particle_spacing, and say why.
     assert_eq!(dp, 0.01, "{how}");
-    assert!(how.contains("coarser spacings not tried: not accurate"), "{how}");
+    assert!(
+        how.contains("coarser spacings not tried: not accurate"),
+        "{how}"
+    );
     assert_eq!(get("scheme"), "dfsph");
     // The bag's parameters record (read by the mcap reader) gives the spacing run, not the one asked for,
     // and how it was chosen.
