@@ -25,5 +25,6 @@ pub mod resolution;
 pub mod ros;
 pub mod runner;
 pub mod signals;
+pub mod sinks;
 pub mod snapshot;
 pub mod transport_bench;

@@ -6,6 +6,7 @@ use crate::config::RecordCfg;
 use crate::motion_source;
 use crate::output::{write_summary, CsvOutputs, Summary};
 use crate::record::{record_state, RecordError, Recorder};
+use crate::sinks::{RecordState, Recording, Sink, SinkError};
 use crate::snapshot::{SnapshotOptions, SnapshotWriter};
 use indicatif::{ProgressBar, ProgressStyle};
 use sph::motion::TankMotion;
@@ -53,10 +54,6 @@ pub struct RunOptions {
     /// Particle frames for ParaView (None: off).
     pub snapshots: Option<SnapshotOptions>,
 }
-
-/// Records one observed state: the outputs and the motion that drove the tank up to it.
-pub type RecordState<'a> =
-    dyn FnMut(&mut Recorder, &sph::observe::Observation) -> Result<(), RecordError> + 'a;
 
 /// What drives a run besides its configuration.
 pub struct Drive<'a> {
@@ -194,14 +191,17 @@ pub fn drive(
     let stop = crate::signals::shutdown_flag().map_err(std::io::Error::other)?;
     let bar = progress_bar(opts.progress, duration);
     let start = Instant::now();
+    let mut recording = record.as_mut().map(|(r, f)| Recording {
+        recorder: r,
+        record: &mut **f,
+    });
+    let mut sinks: Vec<&mut dyn Sink> = vec![&mut outputs];
+    sinks.extend(recording.as_mut().map(|r| r as &mut dyn Sink));
     let result = run_loop(
         sim.as_mut(),
         motion,
-        Sinks {
-            out: &mut outputs,
-            rec: record.as_mut().map(|(r, f)| (r, &mut **f)),
-            snap: snapshots.as_mut().map(|(w, hz)| (w, *hz)),
-        },
+        &mut sinks,
+        snapshots.as_mut().map(|(w, hz)| (w, *hz)),
         &stop,
         Pace {
             duration,
@@ -211,6 +211,7 @@ pub fn drive(
         &bar,
     );
     let wall = start.elapsed().as_secs_f64();
+    drop(sinks);
     bar.finish_and_clear();
     // The CSVs are flushed and the bag finished on every path, also when the solver stopped; the first
     // failure is the one reported (a bag that failed to write usually fails to finish too).
@@ -318,28 +319,18 @@ struct Pace {
     speed: Option<f64>,
 }
 
-/// Where the observed states go: the CSVs, the recording (with how a state is recorded) and the particle
-/// frames (with their rate).
-struct Sinks<'a, 'r> {
-    out: &'a mut CsvOutputs,
-    rec: Option<(&'a mut Recorder, &'a mut RecordState<'r>)>,
-    snap: Option<(&'a mut SnapshotWriter, f64)>,
-}
-
+/// Steps the solver to each output time and hands every observation to the `sinks`, and the particle frames
+/// (with their rate) to `snap`, until the duration or a stop.
 fn run_loop(
     sim: &mut dyn Solver,
     motion: &dyn TankMotion,
-    sinks: Sinks<'_, '_>,
+    sinks: &mut [&mut dyn Sink],
+    mut snap: Option<(&mut SnapshotWriter, f64)>,
     stop: &std::sync::atomic::AtomicBool,
     pace: Pace,
     bar: &ProgressBar,
 ) -> Result<(), LoopError> {
     let (duration, rate) = (pace.duration, pace.output_rate);
-    let Sinks {
-        out,
-        mut rec,
-        mut snap,
-    } = sinks;
     let (mut k, mut j) = (0u64, 0u64);
     let start = Instant::now();
     let mut last_draw = Instant::now();
@@ -348,9 +339,8 @@ fn run_loop(
         let t = sim.time();
         if t >= k as f64 / rate - 1e-9 {
             let o = sim.observe(motion).map_err(LoopError::Solver)?;
-            out.write(&o).map_err(|e| at(t, e))?;
-            if let Some((r, record)) = rec.as_mut() {
-                record(r, &o).map_err(LoopError::Record)?;
+            for s in sinks.iter_mut() {
+                s.observed(&o, motion).map_err(|e| at(t, e))?;
             }
             k = (t * rate + 1e-9).floor() as u64 + 1;
         }
@@ -387,17 +377,22 @@ fn run_loop(
         }
         if last_flush.elapsed() > Duration::from_secs(2) {
             last_flush = Instant::now();
-            out.flush().map_err(|e| at(sim.time(), e))?;
+            for s in sinks.iter_mut() {
+                s.flush().map_err(|e| at(sim.time(), e))?;
+            }
         }
     }
 }
 
-/// An output error at simulation time `t`.
-fn at(t: f64, e: std::io::Error) -> LoopError {
-    LoopError::Io(std::io::Error::new(
-        e.kind(),
-        format!("writing the outputs at t = {t:.4} s: {e}"),
-    ))
+/// A sink's error at simulation time `t` (an output file's says when).
+fn at(t: f64, e: SinkError) -> LoopError {
+    match e {
+        SinkError::Io(e) => LoopError::Io(std::io::Error::new(
+            e.kind(),
+            format!("writing the outputs at t = {t:.4} s: {e}"),
+        )),
+        SinkError::Record(e) => LoopError::Record(e),
+    }
 }
 
 fn progress_bar(enabled: bool, duration: f64) -> ProgressBar {

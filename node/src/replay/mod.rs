@@ -11,7 +11,8 @@ use crate::input::frames::Frames;
 use crate::input::gravity_check::{GravityCheck, InputKind};
 use crate::output::Summary;
 use crate::record::{output_topics, Recorder};
-use crate::runner::{drive, Drive, RecordState, RunError, RunOptions};
+use crate::runner::{drive, Drive, RunError, RunOptions};
+use crate::sinks::RecordState;
 use slosh_msgs::builtin_interfaces::Time;
 use std::path::Path;
 
