@@ -3,28 +3,9 @@
 //! top-level file or folder of `src/`; an import is a `crate::name` path in its code (comments and the
 //! `#[cfg(test)]` module left out).
 
+use slosh_tests::tree::{files, root};
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::{Path, PathBuf};
-
-/// The repository root.
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-/// The Rust files under `dir`, recursively.
-fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            sources(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-}
+use std::path::Path;
 
 /// `text` without its comments and without what follows its `#[cfg(test)]` module.
 fn code(text: &str) -> String {
@@ -66,8 +47,7 @@ fn imported(code: &str) -> BTreeSet<String> {
 
 /// The import graph of a crate's top-level modules: module → the other modules its code names.
 fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
-    let mut files = Vec::new();
-    sources(src, &mut files);
+    let files = files(src, "rs");
     let module = |f: &Path| -> String {
         let rel = f.strip_prefix(src).unwrap();
         let first = rel

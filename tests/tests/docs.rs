@@ -3,28 +3,9 @@
 //! `#anchor` to a heading of the page it names (as mdBook and GitHub derive heading ids), and the tables
 //! made from data are the ones their data make. External links are not followed.
 
+use slosh_tests::tree::{files, root};
 use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
-
-/// The repository root.
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-/// Markdown files under `dir`, recursively.
-fn pages(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            pages(&p, out);
-        } else if p.extension().is_some_and(|x| x == "md") {
-            out.push(p);
-        }
-    }
-}
 
 /// The lines of `text` outside fenced and indented code blocks.
 fn prose(text: &str) -> Vec<&str> {
@@ -133,8 +114,7 @@ fn broken(page: &Path, texts: &mut HashMap<PathBuf, String>) -> Vec<String> {
 #[test]
 fn the_manual_and_the_readme_link_only_to_what_exists() {
     let src = root().join("docs/src");
-    let mut all = Vec::new();
-    pages(&src, &mut all);
+    let mut all = files(&src, "md");
     all.push(root().join("README.md"));
     all.push(root().join("CHANGELOG.md"));
     all.push(root().join("ARCHITECTURE.md"));
@@ -148,8 +128,7 @@ fn every_page_of_the_manual_is_in_its_summary() {
     let src = root().join("docs/src");
     let summary = std::fs::read_to_string(src.join("SUMMARY.md")).unwrap();
     let listed: BTreeSet<PathBuf> = links(&summary).iter().map(|l| src.join(l)).collect();
-    let mut all = Vec::new();
-    pages(&src, &mut all);
+    let all = files(&src, "md");
     let missing: Vec<_> = all
         .iter()
         .filter(|p| p.file_name().unwrap() != "SUMMARY.md" && !listed.contains(*p))
@@ -288,9 +267,7 @@ struct ParamRow {
 /// configuration does not have (named members, or an optional group).
 fn parameter_tables() -> (Vec<ParamRow>, BTreeSet<String>) {
     let (mut rows, mut groups) = (Vec::new(), BTreeSet::new());
-    let mut files = Vec::new();
-    pages(&root().join("docs/src/guide"), &mut files);
-    for f in files {
+    for f in files(&root().join("docs/src/guide"), "md") {
         let text = std::fs::read_to_string(&f).unwrap();
         let (mut under, mut in_table, mut read, mut with_default) =
             (String::new(), false, false, false);
