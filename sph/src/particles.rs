@@ -31,10 +31,10 @@ pub struct Fluid<const D: usize> {
     /// [`HALO`] set on halo copies.
     pub id: Vec<u32>,
     // Interaction copies (f32) and cell of each particle, refreshed every force evaluation.
-    pub x: [Vec<f32>; D],
-    pub v: [Vec<f32>; D],
-    pub r: Vec<f32>,
-    pub p: Vec<f32>,
+    pub x32: [Vec<f32>; D],
+    pub v32: [Vec<f32>; D],
+    pub rho32: Vec<f32>,
+    pub p32: Vec<f32>,
     /// p / ρ², the per-particle factor of the pressure gradient.
     pub pr2: Vec<f32>,
     pub cell: Vec<u32>,
@@ -74,10 +74,10 @@ impl<const D: usize> Default for Fluid<D> {
             kappa: Vec::new(),
             kappa_div: Vec::new(),
             id: Vec::new(),
-            x: vecs(),
-            v: vecs(),
-            r: Vec::new(),
-            p: Vec::new(),
+            x32: vecs(),
+            v32: vecs(),
+            rho32: Vec::new(),
+            p32: Vec::new(),
             pr2: Vec::new(),
             cell: Vec::new(),
             starts: Vec::new(),
@@ -203,28 +203,28 @@ impl<const D: usize> Fluid<D> {
         use rayon::prelude::*;
         let n = self.len();
         for k in 0..D {
-            self.x[k].resize(n, 0.0);
-            self.v[k].resize(n, 0.0);
+            self.x32[k].resize(n, 0.0);
+            self.v32[k].resize(n, 0.0);
         }
-        self.r.resize(n, 0.0);
-        self.p.resize(n, 0.0);
+        self.rho32.resize(n, 0.0);
+        self.p32.resize(n, 0.0);
         self.pr2.resize(n, 0.0);
         self.acc.resize(n, [0.0; D]);
         self.drho.resize(n, 0.0);
         const CH: usize = 4096;
         for k in 0..D {
-            self.x[k]
+            self.x32[k]
                 .par_chunks_mut(CH)
                 .zip(self.pos[k].par_chunks(CH))
                 .for_each(|(o, i)| o.iter_mut().zip(i).for_each(|(o, i)| *o = *i as f32));
-            self.v[k]
+            self.v32[k]
                 .par_chunks_mut(CH)
                 .zip(self.vel[k].par_chunks(CH))
                 .for_each(|(o, i)| o.iter_mut().zip(i).for_each(|(o, i)| *o = *i as f32));
         }
-        self.r
+        self.rho32
             .par_chunks_mut(CH)
-            .zip(self.p.par_chunks_mut(CH))
+            .zip(self.p32.par_chunks_mut(CH))
             .zip(self.pr2.par_chunks_mut(CH))
             .zip(self.rho.par_chunks(CH).zip(self.pressure.par_chunks(CH)))
             .for_each(|(((r, p), pr2), (rho, stored))| {

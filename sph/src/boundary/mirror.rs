@@ -19,8 +19,8 @@ pub fn build_ghosts<const D: usize>(
 ) {
     ghosts.clear();
     for i in 0..fluid.len() {
-        let x: [f64; D] = std::array::from_fn(|k| fluid.x[k][i] as f64);
-        let v: [f64; D] = std::array::from_fn(|k| fluid.v[k][i] as f64);
+        let x: [f64; D] = std::array::from_fn(|k| fluid.x32[k][i] as f64);
+        let v: [f64; D] = std::array::from_fn(|k| fluid.v32[k][i] as f64);
         // For each axis: which face (if any) is within reach, and the mirrored coordinate.
         let mut near = [None; D];
         for k in 0..D {
@@ -44,8 +44,8 @@ pub fn build_ghosts<const D: usize>(
                 }
             }
             let dz: f64 = (0..D).map(|k| g[k] * (xg[k] - x[k])).sum();
-            let rho = fluid.r[i] as f64;
-            let p = fluid.p[i] as f64 + rho * dz;
+            let rho = fluid.rho32[i] as f64;
+            let p = fluid.p32[i] as f64 + rho * dz;
             let rg = eos.density(p);
             ghosts.push(xg, vg, rg, p as f32);
         }

@@ -13,9 +13,9 @@ pub fn pressure<const D: usize, K: Kernel>(
     p: [f64; D],
 ) -> f64 {
     let (mut num, mut den) = (0.0f64, 0.0f64);
-    super::for_each_in_reach(k, grid, &fluid.x, &fluid.starts, p, |j, wk| {
-        let w = (m_fluid / fluid.r[j] * wk) as f64;
-        num += w * fluid.p[j] as f64;
+    super::for_each_in_reach(k, grid, &fluid.x32, &fluid.starts, p, |j, wk| {
+        let w = (m_fluid / fluid.rho32[j] * wk) as f64;
+        num += w * fluid.p32[j] as f64;
         den += w;
     });
     if den < 0.1 {

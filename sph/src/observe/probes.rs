@@ -23,8 +23,8 @@ pub fn fraction<const D: usize, K: Kernel>(
     p: [f64; D],
 ) -> f32 {
     let mut liquid = 0.0f32;
-    super::for_each_in_reach(k, grid, &fluid.x, &fluid.starts, p, |j, w| {
-        liquid += m_fluid / fluid.r[j] * w
+    super::for_each_in_reach(k, grid, &fluid.x32, &fluid.starts, p, |j, w| {
+        liquid += m_fluid / fluid.rho32[j] * w
     });
     let mut wall = 0.0f32;
     super::for_each_in_reach(k, grid, &shell.points.x, &shell.points.starts, p, |_, w| {

@@ -255,11 +255,11 @@ pub fn wall_pressure<const D: usize, K: Kernel>(
         let n = grid.ranges_around(xb, &fluid.starts, &mut ranges);
         for &(lo, hi) in &ranges[..n] {
             for i in lo as usize..hi as usize {
-                let dx: [f32; D] = std::array::from_fn(|d| fluid.x[d][i] - bound.x[d][b]);
+                let dx: [f32; D] = std::array::from_fn(|d| fluid.x32[d][i] - bound.x[d][b]);
                 let r2: f32 = dx.iter().map(|v| v * v).sum();
                 // Only the liquid in front of the face (an obstacle's other faces have liquid too, which
                 // pushes its particles from other sides), up to `slack` behind its plane.
-                let front = (fluid.x[axis][i] - pa) * sign32 < slack;
+                let front = (fluid.x32[axis][i] - pa) * sign32 < slack;
                 if r2 < s2 && front {
                     let g = k.grad_factor(r2.sqrt()) * dx[axis];
                     fn_b += kappa(i) * g as f64 * sign;

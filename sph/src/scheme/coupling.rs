@@ -29,8 +29,8 @@ fn each_liquid_neighbour<const D: usize>(
             if fluid.id[j] & HALO != 0 {
                 continue;
             }
-            let dx: [f32; D] = std::array::from_fn(|d| fluid.x[d][j] - xb[d]);
-            let vd: [f32; D] = std::array::from_fn(|d| fluid.v[d][j] - vb[d]);
+            let dx: [f32; D] = std::array::from_fn(|d| fluid.x32[d][j] - xb[d]);
+            let vd: [f32; D] = std::array::from_fn(|d| fluid.v32[d][j] - vb[d]);
             let r2: f32 = (0..D).map(|d| dx[d] * dx[d]).sum();
             if r2 < support2 {
                 pair(j, dx, vd, r2);
@@ -58,7 +58,7 @@ pub fn liquid_forces<const D: usize, K: Kernel>(
             each_liquid_neighbour(grid, fluid, bound, b, c.support2, |j, dx, vd, r2| {
                 let vr: f32 = (0..D).map(|d| vd[d] * dx[d]).sum();
                 let f = k.grad_factor(r2.sqrt());
-                let ra = fluid.r[j];
+                let ra = fluid.rho32[j];
                 let inv_r2e = 1.0 / (r2 + c.eta2);
                 let mu = c.h * vr.min(0.0) * inv_r2e;
                 let s = fluid.pr2[j]

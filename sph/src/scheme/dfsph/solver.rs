@@ -483,13 +483,13 @@ fn build_chunk<const D: usize, K: Kernel>(
                     .ranges_of_two(cell, (&f.starts, &mut liquid), (&b.starts, &mut walls));
         }
         lists.start.push(lists.j.len() as u32);
-        let xa: [f32; D] = std::array::from_fn(|d| f.x[d][a]);
-        let va: [f32; D] = std::array::from_fn(|d| f.v[d][a]);
+        let xa: [f32; D] = std::array::from_fn(|d| f.x32[d][a]);
+        let va: [f32; D] = std::array::from_fn(|d| f.v32[d][a]);
         let own = (xa, va);
         let around = Rows {
             liquid: &liquid[..nl],
             walls: &walls[..nw],
-            fluid: (&f.x, &f.v),
+            fluid: (&f.x32, &f.v32),
             bound: (&b.x, &b.v),
         };
         let near = (&mut *fs, &mut *bs);
@@ -863,7 +863,7 @@ impl<const D: usize> Workspace<D> {
             component,
             ..
         } = self;
-        let (c, x) = (p.c, &p.fluid.x);
+        let (c, x) = (p.c, &p.fluid.x32);
         corr.resize(factor.len(), correction::identity());
         corr.par_chunks_mut(CHUNK)
             .zip(lists.par_iter())
@@ -1101,10 +1101,10 @@ fn merged(partials: &[Partial]) -> Partial {
     total
 }
 
-/// One DFSPH step of the state's sorted, refreshed liquid (`fluid.x`, `fluid.v` current), at most
+/// One DFSPH step of the state's sorted, refreshed liquid (`fluid.x32`, `fluid.v32` current), at most
 /// `dt_limit` long: solves, then moves `fluid.pos`/`fluid.vel` (f64) by dt, or, when `prime` is set, only
-/// computes the pressures and wall force of the current state and leaves it where it is. Fills `fluid.r`
-/// (summed density) and `fluid.p`.
+/// computes the pressures and wall force of the current state and leaves it where it is. Fills `fluid.rho32`
+/// (summed density) and `fluid.p32`.
 pub fn step<const D: usize, K: Kernel>(
     work: &mut Workspace<D>,
     s: &mut State<D, K>,
@@ -1190,7 +1190,7 @@ pub fn step<const D: usize, K: Kernel>(
         report.totals = built.totals;
         let dtf = dt as f32;
         for (a, v) in work.vel.iter_mut().enumerate() {
-            *v = std::array::from_fn(|d| fluid.v[d][a]);
+            *v = std::array::from_fn(|d| fluid.v32[d][a]);
         }
         work.kdiv.resize(n, 0.0);
         work.kdiv.iter_mut().for_each(|k| *k = 0.0);
@@ -1268,8 +1268,8 @@ pub fn step<const D: usize, K: Kernel>(
             fluid.kappa_div[a] = *kd as f64;
         }
         let p = (k + kd) * r * r;
-        fluid.r[a] = c.rho_rest;
-        fluid.p[a] = p;
+        fluid.rho32[a] = c.rho_rest;
+        fluid.p32[a] = p;
         // Incompressible: every particle stands for the volume m / ρ_rest in the observables.
         fluid.rho[a] = c.rho_rest as f64;
         fluid.pressure[a] = p as f64;

@@ -161,7 +161,7 @@ impl Columns {
             }
             top as u32
         }));
-        let z = &fluid.x[D - 1];
+        let z = &fluid.x32[D - 1];
         let below_top = |&(col, row): &(u32, u32)| row <= self.top_row[col as usize];
         self.top.clear();
         self.top.resize(columns, f32::MIN);
@@ -219,7 +219,7 @@ mod tests {
             .collect();
         let mut f = Fluid::new(&pts, |_| RHO as f64);
         for d in 0..D {
-            f.x[d] = f.pos[d].iter().map(|v| *v as f32).collect();
+            f.x32[d] = f.pos[d].iter().map(|v| *v as f32).collect();
         }
         for (a, p) in pts.iter().enumerate() {
             f.kappa[a] = k(p[axis], 0.45 - p[D - 1]);
@@ -321,7 +321,7 @@ mod tests {
         f.pos[0].push(0.05);
         f.pos[1].push(0.75);
         for d in 0..2 {
-            f.x[d].push(f.pos[d][f.pos[d].len() - 1] as f32);
+            f.x32[d].push(f.pos[d][f.pos[d].len() - 1] as f32);
         }
         f.kappa.push(0.01);
         f.rho.push(RHO as f64);

@@ -196,7 +196,7 @@ impl<const D: usize> Wcsph<D> {
 fn time_step<const D: usize, K: Kernel>(s: &State<D, K>) -> Result<f64, SimError> {
     let spec = &s.params.solver;
     let h = s.coef.h as f64;
-    let rmax = s.fluid.r.iter().fold(s.coef.rho0, |m, &r| m.max(r));
+    let rmax = s.fluid.rho32.iter().fold(s.coef.rho0, |m, &r| m.max(r));
     let mut max = [rmax as f64, s.last.max_acc as f64, s.last.max_mu as f64];
     if let Some(dom) = &s.dom {
         // The maxima over all ranks (not the least of each rank's step: c and μ add up).

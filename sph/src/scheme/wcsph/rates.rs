@@ -309,9 +309,9 @@ pub fn fluid_rates<const D: usize, K: Kernel>(
     work: &mut Workspace<D>,
 ) -> PassTotals {
     let Fluid {
-        x,
-        v,
-        r,
+        x32: x,
+        v32: v,
+        rho32: r,
         pr2,
         cell,
         starts,
@@ -393,9 +393,9 @@ pub fn wall_density_rates<const D: usize, K: Kernel>(
                         let mut r2 = 0.0f32;
                         let mut vr = 0.0f32;
                         for d in 0..D {
-                            let dx = xb[d] - fluid.x[d][j];
+                            let dx = xb[d] - fluid.x32[d][j];
                             r2 += dx * dx;
-                            vr += (vb[d] - fluid.v[d][j]) * dx;
+                            vr += (vb[d] - fluid.v32[d][j]) * dx;
                         }
                         if r2 < c.support2 {
                             s += vr * k.grad_factor(r2.sqrt());
