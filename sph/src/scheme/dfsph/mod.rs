@@ -13,9 +13,9 @@
 //!    corrects it until the mean predicted density error is below the tolerance (the constant-density
 //!    solver). The divergence solve starts from half its last pressure, the constant-density solve from the
 //!    hydrostatic part of its last pressure whole and 0.6 of the rest ([`warm_start`]); both iterate
-//!    `k_i = ω · max(error_i, 0) · α_i / dt^n` (ω = `relaxation`, 0.7, or 0.5 with corrected gradients: at 1 the Jacobi iterations amplify
-//!    the particle-to-particle pressure modes of the 3D kernel's 81 neighbours and a tank at rest stirs
-//!    itself),
+//!    `k_i = ω · max(error_i, 0) · α_i / dt^n` (ω = `relaxation`, 0.7, or 0.5 with corrected gradients: at 1
+//!    the Jacobi iterations amplify the particle-to-particle pressure modes of the 3D kernel's 81 neighbours
+//!    and a tank at rest stirs itself),
 //!    `Δv_i = −dt Σ_j m_j (k_i + k_j) ∇W_ij − dt Σ_b m_b k_i ∇W_ib` (k plays p/ρ², so p = ρ² Σ k);
 //!    A constant-density solve that stops at `max_iterations` above the tolerance is done again, with the
 //!    divergence solve, at half the step (nothing has moved yet);
