@@ -83,6 +83,16 @@ impl<const D: usize, K: Kernel> State<D, K> {
         }
     }
 
+    /// The error of a step `dt` shorter than the shortest allowed, taken from the current time.
+    pub(crate) fn step_collapsed(&self, dt: f64) -> SimError {
+        SimError::TimeStepCollapsed {
+            time: self.time,
+            step: self.stats.steps,
+            dt,
+            dt_min: self.dt_min,
+        }
+    }
+
     /// The frame terms of the motion at t (across ranks: rank 0's motion, broadcast).
     pub(crate) fn frame(&self, motion: &dyn TankMotion, t: f64) -> FrameTerms {
         let local = || {

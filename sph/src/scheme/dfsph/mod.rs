@@ -186,12 +186,7 @@ impl<const D: usize, K: Kernel> PressureScheme<D, K> for Dfsph<D> {
         Self::count(s, &r);
         debug_assert!(r.dt <= s.params.solver.dfsph.dt_max);
         if !(r.dt >= s.dt_min) {
-            return Err(SimError::TimeStepCollapsed {
-                time: t,
-                step: s.stats.steps,
-                dt: r.dt,
-                dt_min: s.dt_min,
-            });
+            return Err(s.step_collapsed(r.dt));
         }
         if !s.bodies.is_empty() {
             // The bodies move with the liquid's force over the step, from the positions it was solved at.
@@ -201,11 +196,11 @@ impl<const D: usize, K: Kernel> PressureScheme<D, K> for Dfsph<D> {
             }
             s.contain_bodies();
         }
-        // The tank's walls alone: less the bodies' share of the boundary's force.
-        let b = &s.bodies;
+        // The tank's walls alone (the solve's totals are the state's last ones).
+        let (force, moment) = s.tank_wall_totals();
         for k in 0..3 {
-            self.impulse.force[k] += (r.totals.force[k] + b.total_force[k]) * r.dt;
-            self.impulse.moment[k] += (r.totals.moment[k] + b.total_moment[k]) * r.dt;
+            self.impulse.force[k] += force[k] * r.dt;
+            self.impulse.moment[k] += moment[k] * r.dt;
         }
         self.impulse_time += r.dt;
         s.finish_step(t, r.dt, end);

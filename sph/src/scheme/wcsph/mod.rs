@@ -216,12 +216,7 @@ fn time_step<const D: usize, K: Kernel>(s: &State<D, K>) -> Result<f64, SimError
     }
     dt = dt.min(spec.dt_max);
     if !(dt >= s.dt_min) {
-        return Err(SimError::TimeStepCollapsed {
-            time: s.time,
-            step: s.stats.steps,
-            dt,
-            dt_min: s.dt_min,
-        });
+        return Err(s.step_collapsed(dt));
     }
     Ok(dt)
 }
