@@ -15,50 +15,12 @@
 //!
 //! `--png FILE` also draws the figure as a PNG (to look at without an SVG viewer).
 use plotters::prelude::*;
+use slosh_node::accuracy::{csv, read_csv, Row, SETTINGS};
 use slosh_node::plot::figure::{self, Figure, Panel, Series};
-use sph::kernel::KernelKind;
-use sph::params::{Scheme, SimParams};
 use sph::sloshing::experiment::{free_decay, seed_tank};
-use std::fmt::Write;
 use std::path::Path;
 
-/// A scheme setting: its name in the table and what it changes from `seed_tank`'s defaults.
-struct Setting {
-    name: &'static str,
-    apply: fn(&mut SimParams),
-}
-
-const SETTINGS: [Setting; 3] = [
-    Setting {
-        name: "dfsph (shipped)",
-        apply: |p| p.solver.scheme = Scheme::Dfsph,
-    },
-    Setting {
-        name: "dfsph + kernel_correction, wendland, α 0",
-        apply: |p| {
-            p.solver.scheme = Scheme::Dfsph;
-            p.solver.kernel = KernelKind::Wendland;
-            p.solver.dfsph.kernel_correction = true;
-            p.solver.artificial_viscosity.alpha = 0.0;
-        },
-    },
-    Setting {
-        name: "wcsph (shipped)",
-        apply: |p| p.solver.scheme = Scheme::Wcsph,
-    },
-];
-
 const FILLS: [f64; 2] = [0.19, 0.39];
-
-/// One free decay.
-struct Row {
-    setting: String,
-    dim: usize,
-    fill: f64,
-    dp: f64,
-    /// Period, theory period, damping ratio, laminar damping ratio, wall seconds; or why it failed.
-    result: Result<[f64; 5], String>,
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -72,7 +34,7 @@ fn main() {
     let data = root.join("docs/src/validation/convergence.csv");
     if args.iter().any(|a| a == "--redraw") {
         let text = std::fs::read_to_string(&data).expect("docs/src/validation/convergence.csv");
-        let (rows, heading) = read_csv(&text);
+        let (rows, heading) = read_csv(&text).expect("the CSV this command writes");
         write(&root, &rows, &heading, png);
         return;
     }
@@ -111,9 +73,9 @@ fn main() {
                     .map_err(|e| e.to_string());
                 let row = Row {
                     setting: s.name.to_string(),
-                    dim,
+                    dimension: dim,
                     fill,
-                    dp,
+                    spacing: dp,
                     result,
                 };
                 println!("{}", table_row(&row));
@@ -135,68 +97,8 @@ fn main() {
         .unwrap_or_else(|| "unknown CPU".into());
     let threads = rayon::current_num_threads();
     let heading = format!("{machine} ({threads} threads)");
-    let mut csv = format!("# {heading}\n{CSV_HEADER}\n");
-    for r in &rows {
-        match &r.result {
-            Ok([t, t0, z, zl, w]) => writeln!(
-                csv,
-                "\"{}\",{},{},{},{t:.6},{t0:.6},{:.6},{z:.6},{zl:.6},{w:.1},",
-                r.setting,
-                r.dim,
-                r.fill,
-                r.dp,
-                t / t0 - 1.0
-            ),
-            Err(e) => writeln!(
-                csv,
-                "\"{}\",{},{},{},,,,,,,\"{}\"",
-                r.setting,
-                r.dim,
-                r.fill,
-                r.dp,
-                e.replace('"', "'")
-            ),
-        }
-        .unwrap();
-    }
-    std::fs::write(&data, csv).unwrap();
+    std::fs::write(&data, csv(&heading, &rows)).unwrap();
     write(&root, &rows, &heading, png);
-}
-
-const CSV_HEADER: &str = "setting,dimension,fill_m,dp_m,period_s,theory_period_s,period_error,damping_ratio,laminar_damping_ratio,wall_s,error";
-
-/// The rows of the CSV this command writes, and its first line's machine.
-fn read_csv(text: &str) -> (Vec<Row>, String) {
-    let mut lines = text.lines();
-    let heading = lines
-        .next()
-        .and_then(|l| l.strip_prefix("# "))
-        .expect("the CSV's first line names the machine")
-        .to_string();
-    assert_eq!(lines.next(), Some(CSV_HEADER), "the CSV's columns");
-    let rows = lines
-        .map(|l| {
-            // The setting is quoted (its name has commas), the error too.
-            let (setting, rest) = l[1..].split_once("\",").expect("a quoted setting");
-            let f: Vec<&str> = std::iter::once(setting)
-                .chain(rest.splitn(10, ','))
-                .collect();
-            let num = |i: usize| f[i].parse::<f64>().expect("a number");
-            let result = if f[10].is_empty() {
-                Ok([num(4), num(5), num(7), num(8), num(9)])
-            } else {
-                Err(f[10].trim_matches('"').to_string())
-            };
-            Row {
-                setting: f[0].to_string(),
-                dim: f[1].parse().expect("a dimension"),
-                fill: num(2),
-                dp: num(3),
-                result,
-            }
-        })
-        .collect();
-    (rows, heading)
 }
 
 /// The manual's table and figure from `rows`.
@@ -242,9 +144,9 @@ fn table_row(r: &Row) -> String {
     let head = format!(
         "| {} | {}D | {} | {:.0} |",
         r.setting,
-        r.dim,
+        r.dimension,
         r.fill,
-        r.dp * 1000.0
+        r.spacing * 1000.0
     );
     match &r.result {
         Ok([t, t0, z, zl, w]) => format!(
@@ -279,8 +181,8 @@ fn convergence_figure(rows: &[Row]) -> Figure {
             for fill in FILLS {
                 let points: Vec<(f64, [f64; 5])> = rows
                     .iter()
-                    .filter(|r| r.setting == s.name && r.dim == dim && r.fill == fill)
-                    .filter_map(|r| r.result.as_ref().ok().map(|v| (r.dp * 1000.0, *v)))
+                    .filter(|r| r.setting == s.name && r.dimension == dim && r.fill == fill)
+                    .filter_map(|r| r.result.as_ref().ok().map(|v| (r.spacing * 1000.0, *v)))
                     .collect();
                 if points.is_empty() {
                     continue;
@@ -307,8 +209,8 @@ fn convergence_figure(rows: &[Row]) -> Figure {
         for fill in FILLS {
             let laminar: Vec<(f64, f64)> = rows
                 .iter()
-                .filter(|r| r.dim == dim && r.fill == fill)
-                .filter_map(|r| r.result.as_ref().ok().map(|v| (r.dp * 1000.0, v[3])))
+                .filter(|r| r.dimension == dim && r.fill == fill)
+                .filter_map(|r| r.result.as_ref().ok().map(|v| (r.spacing * 1000.0, v[3])))
                 .collect();
             if let (Some(lo), Some(hi)) = (
                 laminar.iter().map(|p| p.0).reduce(f64::min),
