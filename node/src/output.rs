@@ -45,9 +45,12 @@ impl Csv {
         })
     }
 
-    /// Appends whole lines.
+    /// Appends whole lines and writes them out: every file holds the rows up to the last output time, so a
+    /// disk that fills leaves each file its rows up to about the same time (a buffer that filled up first
+    /// would otherwise take the last room and leave another file empty).
     fn append(&mut self, lines: &str) -> std::io::Result<()> {
-        self.w.write_all(lines.as_bytes()).map_err(|e| {
+        let w = &mut self.w;
+        w.write_all(lines.as_bytes()).and_then(|()| w.flush()).map_err(|e| {
             self.failed = true;
             named(&self.path, e)
         })
