@@ -23,13 +23,21 @@ pub const CASES: &[Case] = &[
     Case {
         name: "seed_2d_dp8mm",
         builtin: "seed_tank_039",
-        overrides: &["dimension=2", "particle_spacing=0.008"],
+        overrides: &[
+            "dimension=2",
+            "particle_spacing=0.008",
+            "solver.scheme=wcsph",
+        ],
         duration: 2.0,
     },
     Case {
         name: "seed_3d_dp20mm",
         builtin: "seed_tank_039",
-        overrides: &["dimension=3", "particle_spacing=0.02"],
+        overrides: &[
+            "dimension=3",
+            "particle_spacing=0.02",
+            "solver.scheme=wcsph",
+        ],
         duration: 1.0,
     },
     Case {
