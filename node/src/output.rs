@@ -50,10 +50,12 @@ impl Csv {
     /// would otherwise take the last room and leave another file empty).
     fn append(&mut self, lines: &str) -> std::io::Result<()> {
         let w = &mut self.w;
-        w.write_all(lines.as_bytes()).and_then(|()| w.flush()).map_err(|e| {
-            self.failed = true;
-            named(&self.path, e)
-        })
+        w.write_all(lines.as_bytes())
+            .and_then(|()| w.flush())
+            .map_err(|e| {
+                self.failed = true;
+                named(&self.path, e)
+            })
     }
 
     /// Writes the buffered rows out and closes the file; if that fails, cuts the file after its last whole

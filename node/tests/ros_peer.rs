@@ -136,3 +136,139 @@ fn cyclonedds_peer_drives_the_node_and_reads_its_outputs() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The rcl_interfaces parameter services, called by the same third-party peer: every parameter listed
+/// with its type, described (read-only or changeable, with a range), a rate changed while the node runs
+/// (the outputs follow at once), a read-only parameter and an atomic set with one refused with the reason,
+/// and the change on `/parameter_events`.
+#[test]
+fn cyclonedds_peer_lists_gets_and_sets_the_node_parameters() {
+    if !common::in_private_netns("cyclonedds_peer_lists_gets_and_sets_the_node_parameters") {
+        return;
+    }
+    let (dir, case) = common::case_dir("ros-peer-params", "");
+    let domain = "24";
+    let mut node = common::slosh()
+        .args(["node", "--duration", "3.0", "--ros-args", "--params-file"])
+        .arg(&case)
+        .args(["-r", "__ns:=/peer", "-p", "realtime.mode:=lockstep"])
+        .env("ROS_DOMAIN_ID", domain)
+        .spawn()
+        .unwrap();
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/py/peer_cyclonedds.py"
+    );
+    let out = Command::new(common::python())
+        .arg(script)
+        .args(["--domain", domain, "--ns", "/peer", "--seconds", "3"])
+        .args(["--t0", "2000", "--parameters", "slosh"])
+        .stderr(Stdio::inherit())
+        .output()
+        .unwrap();
+    let _ = node.kill();
+    let _ = node.wait();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "the cyclonedds peer failed: {text}");
+    let v: serde_json::Value =
+        serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"));
+    let p = &v["parameters"];
+    let listed: Vec<&str> = p["list"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    for n in [
+        "output_rate_hz",
+        "particle_spacing",
+        "solver.scheme",
+        "solver.dfsph.max_iterations",
+        "particles.decimation",
+        "probes.names",
+        "use_sim_time",
+    ] {
+        assert!(listed.contains(&n), "{n} not listed: {listed:?}");
+    }
+    assert!(listed.len() > 50, "{} parameters", listed.len());
+    assert!(p["prefixes"]
+        .as_array()
+        .unwrap()
+        .contains(&serde_json::json!("solver.dfsph")));
+    for n in p["solver_depth1"].as_array().unwrap() {
+        let n = n.as_str().unwrap();
+        assert!(
+            n.starts_with("solver.") && n.matches('.').count() == 1,
+            "{n}"
+        );
+    }
+    // Values and types as ROS 2 types them (double 3, string 4, string array 9, not set 0).
+    let g = &p["get"];
+    assert_eq!(
+        g["output_rate_hz"],
+        serde_json::json!({"type": 3, "value": 20.0})
+    );
+    assert_eq!(
+        g["particle_spacing"],
+        serde_json::json!({"type": 3, "value": 0.02})
+    );
+    assert_eq!(g["solver.scheme"]["type"], 4);
+    assert_eq!(
+        g["probes.names"],
+        serde_json::json!({"type": 9, "value": ["left", "mid"]})
+    );
+    assert_eq!(g["no_such"]["type"], 0);
+    assert_eq!(p["types"], serde_json::json!([3, 3, 4, 9, 0]));
+    let d = &p["describe"];
+    assert_eq!(d[0]["read_only"], false);
+    assert_eq!(d[0]["range"], serde_json::json!([[0.01, 1000.0]]));
+    assert_eq!(d[1]["read_only"], true);
+    assert!(d[1]["constraints"].as_str().unwrap().contains("restart"));
+    // The set: the rate applies, the spacing is refused with the reason.
+    assert_eq!(p["set"][0]["ok"], true, "{}", p["set"]);
+    assert_eq!(p["set"][1]["ok"], false);
+    assert!(p["set"][1]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("read-only"));
+    assert_eq!(p["atomic"]["ok"], false);
+    assert!(p["atomic"]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("'dimension'"));
+    // The outputs: 20 Hz before the set, 10 Hz after it (stamps on the input's time base, t0 removed).
+    let times: Vec<f64> = v["wrench_times"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect();
+    let set_at = p["set_at"].as_f64().unwrap();
+    let gaps = |from: f64, to: f64| -> Vec<f64> {
+        times
+            .windows(2)
+            .filter(|w| w[0] >= from && w[1] <= to)
+            .map(|w| w[1] - w[0])
+            .collect()
+    };
+    let before = gaps(0.0, set_at - 0.1);
+    let after = gaps(set_at + 0.2, 10.0);
+    assert!(
+        !before.is_empty() && before.iter().all(|g| (g - 0.05).abs() < 1e-3),
+        "before the set: {before:?}"
+    );
+    assert!(
+        !after.is_empty() && after.iter().all(|g| (g - 0.1).abs() < 1e-3),
+        "after the set: {after:?}"
+    );
+    // /parameter_events carries the change. (The start-up event that declares every parameter is
+    // volatile, as rclcpp's: a peer that joins later does not see it.)
+    let events = p["events"].as_array().unwrap();
+    assert!(
+        events.iter().any(
+            |e| e["changed"]["output_rate_hz"] == serde_json::json!({"type": 3, "value": 10.0})
+        ),
+        "{events:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

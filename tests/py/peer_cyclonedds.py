@@ -9,6 +9,12 @@ slosh_msgs/PressureArray and diagnostic_msgs/DiagnosticArray (reliable). Prints 
 counts and the last values received.
 
     peer_cyclonedds.py --domain 23 --ns /peer --seconds 4 --t0 2000
+
+With ``--parameters NODE`` it also calls the node's rcl_interfaces parameter services (request
+``rq/<ns>/<node>/<service>Request``, reply ``rr/<ns>/<node>/<service>Reply``, the enhanced
+request/reply mapping): lists, gets, types and describes before the motion, sets ``output_rate_hz`` to
+10 Hz halfway through it, and tries an atomic set that includes a read-only parameter; it reads
+``/parameter_events`` throughout. The answers go under ``parameters`` in the JSON.
 """
 
 import argparse
@@ -25,9 +31,13 @@ from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
-from ros_types import (DiagnosticArray, Header, Odometry, Point, PointCloud2, Pose, PoseWithCovariance,
-                       PressureArray, ProbeArray, Quaternion, Time, Twist, TwistWithCovariance,
-                       Vector3, WrenchStamped)
+from ros_types import (DescribeParametersRequest, DescribeParametersResponse, DiagnosticArray,
+                       GetParametersRequest, GetParametersResponse, GetParameterTypesRequest,
+                       GetParameterTypesResponse, Header, ListParametersRequest, ListParametersResponse,
+                       Odometry, Parameter, ParameterEvent, ParameterValue, Point, PointCloud2, Pose,
+                       PoseWithCovariance, PressureArray, ProbeArray, Quaternion, SetParametersAtomicallyRequest,
+                       SetParametersAtomicallyResponse, SetParametersRequest, SetParametersResponse, Time,
+                       Twist, TwistWithCovariance, Vector3, WrenchStamped)
 
 
 def stamp(t):
@@ -39,6 +49,57 @@ def level(v):
     return v[0] if isinstance(v, (bytes, bytearray)) else int(v)
 
 
+def value(**kw):
+    """An rcl_interfaces ParameterValue with the given fields, the rest empty."""
+    v = dict(type=0, bool_value=False, integer_value=0, double_value=0.0, string_value="",
+             byte_array_value=[], bool_array_value=[], integer_array_value=[], double_array_value=[],
+             string_array_value=[])
+    v.update(kw)
+    return ParameterValue(**v)
+
+
+def plain(v):
+    """A ParameterValue as a JSON-friendly dict of its set field."""
+    fields = {1: "bool_value", 2: "integer_value", 3: "double_value", 4: "string_value",
+              6: "bool_array_value", 7: "integer_array_value", 8: "double_array_value",
+              9: "string_array_value"}
+    t = level(v.type)
+    got = getattr(v, fields[t]) if t in fields else None
+    return {"type": t, "value": list(got) if isinstance(got, (list, tuple)) else got}
+
+
+class Services:
+    """A client of the node's parameter services over plain DDS."""
+
+    def __init__(self, dp, prefix, qos, drain):
+        self.dp, self.prefix, self.qos, self.drain = dp, prefix, qos, drain
+        self.ends = {}
+
+    def open(self, name, req, resp):
+        w = DataWriter(self.dp, Topic(self.dp, f"rq{self.prefix}/{name}Request", req), qos=self.qos)
+        r = DataReader(self.dp, Topic(self.dp, f"rr{self.prefix}/{name}Reply", resp), qos=self.qos)
+        self.ends[name] = (w, r, resp)
+
+    def call(self, name, request, timeout=15.0):
+        w, r, resp = self.ends[name]
+        end = time.monotonic() + timeout
+        while (w.get_publication_matched_status().current_count == 0
+               or r.get_subscription_matched_status().current_count == 0):
+            if time.monotonic() > end:
+                raise RuntimeError(f"{name}: the node's service never matched")
+            self.drain()
+            time.sleep(0.02)
+        time.sleep(0.2)
+        w.write(request)
+        while time.monotonic() < end:
+            for s in r.take(N=16):
+                if isinstance(s, resp):
+                    return s
+            self.drain()
+            time.sleep(0.01)
+        raise RuntimeError(f"{name}: no reply")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--domain", type=int, required=True)
@@ -47,6 +108,7 @@ def main():
     ap.add_argument("--rate", type=float, default=50.0)
     ap.add_argument("--t0", type=float, default=2000.0, help="stamp of the first sample")
     ap.add_argument("--timeout", type=float, default=60.0)
+    ap.add_argument("--parameters", default="", help="the node's name: call its parameter services")
     a = ap.parse_args()
     ns = a.ns.rstrip("/")
 
@@ -61,7 +123,10 @@ def main():
         "diagnostics": DataReader(dp, Topic(dp, "rt/diagnostics", DiagnosticArray), qos=reliable),
         "particles": DataReader(dp, Topic(dp, f"rt{ns}/particles", PointCloud2), qos=reliable),
     }
-    types = {"wrench": WrenchStamped, "probes": ProbeArray, "pressures": PressureArray,
+    if a.parameters:
+        events_qos = Qos(Policy.Reliability.Reliable(duration(milliseconds=200)), Policy.History.KeepLast(1000))
+        readers["events"] = DataReader(dp, Topic(dp, "rt/parameter_events", ParameterEvent), qos=events_qos)
+    types = {"events": ParameterEvent, "wrench": WrenchStamped, "probes": ProbeArray, "pressures": PressureArray,
              "diagnostics": DiagnosticArray, "particles": PointCloud2}
     got = {k: [] for k in readers}
 
@@ -82,6 +147,34 @@ def main():
         time.sleep(0.02)
     time.sleep(0.3)
 
+    params = {}
+    if a.parameters:
+        svc = Services(dp, f"{ns}/{a.parameters}",
+                       Qos(Policy.Reliability.Reliable(duration(milliseconds=200)), Policy.History.KeepLast(10)),
+                       drain)
+        svc.open("list_parameters", ListParametersRequest, ListParametersResponse)
+        svc.open("get_parameters", GetParametersRequest, GetParametersResponse)
+        svc.open("get_parameter_types", GetParameterTypesRequest, GetParameterTypesResponse)
+        svc.open("describe_parameters", DescribeParametersRequest, DescribeParametersResponse)
+        svc.open("set_parameters", SetParametersRequest, SetParametersResponse)
+        svc.open("set_parameters_atomically", SetParametersAtomicallyRequest, SetParametersAtomicallyResponse)
+        asked = ["output_rate_hz", "particle_spacing", "solver.scheme", "probes.names", "no_such"]
+        listed = svc.call("list_parameters", ListParametersRequest(prefixes=[], depth=0)).result
+        solver = svc.call("list_parameters", ListParametersRequest(prefixes=["solver"], depth=1)).result
+        vals = svc.call("get_parameters", GetParametersRequest(names=asked)).values
+        kinds = svc.call("get_parameter_types", GetParameterTypesRequest(names=asked)).types
+        described = svc.call("describe_parameters", DescribeParametersRequest(names=asked[:2])).descriptors
+        params = {
+            "list": list(listed.names), "prefixes": list(listed.prefixes),
+            "solver_depth1": list(solver.names),
+            "get": {n: plain(v) for n, v in zip(asked, vals)},
+            "types": [level(k) for k in kinds],
+            "describe": [{"name": d.name, "type": level(d.type), "read_only": bool(d.read_only),
+                          "constraints": d.additional_constraints,
+                          "range": [[r.from_value, r.to_value] for r in d.floating_point_range]}
+                         for d in described],
+        }
+
     # A tank at rest, 5 km east and 300 m south of the origin, heading 0.3 rad.
     yaw = 0.3
     pose = Pose(position=Point(x=5000.0, y=-300.0, z=2.0),
@@ -94,6 +187,18 @@ def main():
         while time.monotonic() - t_start < t:
             drain()
             time.sleep(0.002)
+        if a.parameters and k == n // 2:
+            # Halfway: 10 Hz outputs from now on, and a spacing the running node cannot take.
+            res = svc.call("set_parameters", SetParametersRequest(parameters=[
+                Parameter(name="output_rate_hz", value=value(type=3, double_value=10.0)),
+                Parameter(name="particle_spacing", value=value(type=3, double_value=0.01))])).results
+            params["set"] = [{"ok": bool(r.successful), "reason": r.reason} for r in res]
+            params["set_at"] = t
+            res = svc.call("set_parameters_atomically", SetParametersAtomicallyRequest(parameters=[
+                Parameter(name="diagnostics_rate_hz", value=value(type=3, double_value=2.0)),
+                Parameter(name="dimension", value=value(type=2, integer_value=2))])).result
+            params["atomic"] = {"ok": bool(res.successful), "reason": res.reason}
+            t_start += time.monotonic() - t_start - t
         odom_w.write(Odometry(
             header=Header(stamp=stamp(a.t0 + t), frame_id="odom"),
             child_frame_id="base_link",
@@ -118,7 +223,12 @@ def main():
         fmt = ">f" if cloud.is_bigendian else "<f"
         return [{k: struct.unpack_from(fmt, raw, i * cloud.point_step + o)[0] for k, o in offs.items()}
                 for i in range(cloud.width * cloud.height)]
+    if a.parameters:
+        params["events"] = [{"node": e.node, "new": [p.name for p in e.new_parameters],
+                             "changed": {p.name: plain(p.value) for p in e.changed_parameters}}
+                            for e in got["events"]]
     out = {
+        "parameters": params,
         "counts": {k: len(v) for k, v in got.items()},
         "wrench_last": None if not w else {
             "t": t_of(w[-1].header), "frame_id": w[-1].header.frame_id,

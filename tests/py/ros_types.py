@@ -241,3 +241,138 @@ class EmptyRequest(IdlStruct, typename="std_srvs::srv::dds_::Empty_Request_"):
 @dataclass
 class EmptyResponse(IdlStruct, typename="std_srvs::srv::dds_::Empty_Response_"):
     structure_needs_at_least_one_member: t.uint8
+
+
+# rcl_interfaces: the parameter services every ROS 2 node serves, and /parameter_events.
+
+@dataclass
+class ParameterValue(IdlStruct, typename="rcl_interfaces::msg::dds_::ParameterValue_"):
+    type: t.uint8
+    bool_value: bool
+    integer_value: t.int64
+    double_value: t.float64
+    string_value: str
+    byte_array_value: t.sequence[t.uint8]
+    bool_array_value: t.sequence[bool]
+    integer_array_value: t.sequence[t.int64]
+    double_array_value: t.sequence[t.float64]
+    string_array_value: t.sequence[str]
+
+
+@dataclass
+class Parameter(IdlStruct, typename="rcl_interfaces::msg::dds_::Parameter_"):
+    name: str
+    value: ParameterValue
+
+
+@dataclass
+class FloatingPointRange(IdlStruct, typename="rcl_interfaces::msg::dds_::FloatingPointRange_"):
+    from_value: t.float64
+    to_value: t.float64
+    step: t.float64
+
+
+@dataclass
+class IntegerRange(IdlStruct, typename="rcl_interfaces::msg::dds_::IntegerRange_"):
+    from_value: t.int64
+    to_value: t.int64
+    step: t.uint64
+
+
+@dataclass
+class ParameterDescriptor(IdlStruct, typename="rcl_interfaces::msg::dds_::ParameterDescriptor_"):
+    name: str
+    type: t.uint8
+    description: str
+    additional_constraints: str
+    read_only: bool
+    dynamic_typing: bool
+    floating_point_range: t.sequence[FloatingPointRange, 1]
+    integer_range: t.sequence[IntegerRange, 1]
+
+
+@dataclass
+class SetParametersResult(IdlStruct, typename="rcl_interfaces::msg::dds_::SetParametersResult_"):
+    successful: bool
+    reason: str
+
+
+@dataclass
+class ListParametersResult(IdlStruct, typename="rcl_interfaces::msg::dds_::ListParametersResult_"):
+    names: t.sequence[str]
+    prefixes: t.sequence[str]
+
+
+@dataclass
+class ParameterEvent(IdlStruct, typename="rcl_interfaces::msg::dds_::ParameterEvent_"):
+    stamp: Time
+    node: str
+    new_parameters: t.sequence[Parameter]
+    changed_parameters: t.sequence[Parameter]
+    deleted_parameters: t.sequence[Parameter]
+
+
+@dataclass
+class ListParametersRequest(IdlStruct, typename="rcl_interfaces::srv::dds_::ListParameters_Request_"):
+    prefixes: t.sequence[str]
+    depth: t.uint64
+
+
+@dataclass
+class ListParametersResponse(IdlStruct, typename="rcl_interfaces::srv::dds_::ListParameters_Response_"):
+    result: ListParametersResult
+
+
+@dataclass
+class GetParametersRequest(IdlStruct, typename="rcl_interfaces::srv::dds_::GetParameters_Request_"):
+    names: t.sequence[str]
+
+
+@dataclass
+class GetParametersResponse(IdlStruct, typename="rcl_interfaces::srv::dds_::GetParameters_Response_"):
+    values: t.sequence[ParameterValue]
+
+
+@dataclass
+class GetParameterTypesRequest(IdlStruct, typename="rcl_interfaces::srv::dds_::GetParameterTypes_Request_"):
+    names: t.sequence[str]
+
+
+@dataclass
+class GetParameterTypesResponse(IdlStruct,
+                                typename="rcl_interfaces::srv::dds_::GetParameterTypes_Response_"):
+    types: t.sequence[t.uint8]
+
+
+@dataclass
+class DescribeParametersRequest(IdlStruct,
+                                typename="rcl_interfaces::srv::dds_::DescribeParameters_Request_"):
+    names: t.sequence[str]
+
+
+@dataclass
+class DescribeParametersResponse(IdlStruct,
+                                 typename="rcl_interfaces::srv::dds_::DescribeParameters_Response_"):
+    descriptors: t.sequence[ParameterDescriptor]
+
+
+@dataclass
+class SetParametersRequest(IdlStruct, typename="rcl_interfaces::srv::dds_::SetParameters_Request_"):
+    parameters: t.sequence[Parameter]
+
+
+@dataclass
+class SetParametersResponse(IdlStruct, typename="rcl_interfaces::srv::dds_::SetParameters_Response_"):
+    results: t.sequence[SetParametersResult]
+
+
+@dataclass
+class SetParametersAtomicallyRequest(IdlStruct,
+                                     typename="rcl_interfaces::srv::dds_::SetParametersAtomically_Request_"):
+    parameters: t.sequence[Parameter]
+
+
+@dataclass
+class SetParametersAtomicallyResponse(IdlStruct,
+                                      typename="rcl_interfaces::srv::dds_::SetParametersAtomically_Response_"):
+    result: SetParametersResult

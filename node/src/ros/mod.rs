@@ -7,6 +7,7 @@ pub mod graph_hint;
 pub mod motion_pub;
 pub mod node;
 pub mod pacing;
+pub mod parameters;
 
 use ros2_client::{Context, ContextOptions, MessageTypeName, Name, Node, QosProfile};
 use slosh_msgs::RosMessage;

@@ -4,6 +4,7 @@
 
 use super::args::{Names, RosArgs};
 use super::pacing::Pacing;
+use super::parameters::{LiveSettings, ParameterServers, Parameters};
 use super::publish;
 use crate::config::{InputType, Loaded, RealtimeMode, StampSource, DEFAULT_NAME};
 use crate::input::frames::Frames;
@@ -545,9 +546,15 @@ pub fn run(
             &super::ros_name(&names, "~/pause")?,
             &ServiceTypeName::new("std_srvs", "SetBool"),
             srv_qos.clone(),
-            srv_qos,
+            srv_qos.clone(),
         )
         .map_err(|e| anyhow::anyhow!("service ~/pause: {e:?}"))?;
+    let mut param_srv = ParameterServers::new(&mut node, &names, mapping, &srv_qos)?;
+    let mut param_table = Parameters::new(
+        &cfg.effective_parameters(&params),
+        c.realtime.mode == RealtimeMode::FollowClock,
+        c.particles.rate_hz > 0.0,
+    );
 
     let frames = Frames::new(c.input.world_frame, c.input.body_frame, c.frames.tank_pose);
     let imu = c.input.kind == InputType::Imu;
@@ -631,7 +638,14 @@ pub fn run(
         ..Default::default()
     };
     let mut t0: Option<f64> = None;
-    let rate = c.output_rate_hz;
+    // What a parameter set changes while the node runs.
+    let mut live = LiveSettings {
+        output_rate_hz: c.output_rate_hz,
+        diagnostics_rate_hz: c.diagnostics_rate_hz,
+        particles_rate_hz: c.particles.rate_hz,
+        particles_decimation: c.particles.decimation,
+        motion_timeout_s: c.motion_timeout_s,
+    };
     // Outputs at k / rate (the steps land on them), the first the state at t = 0 before any step.
     let mut next_output = 0u64;
     let mut last_diag = DiagClock {
@@ -732,6 +746,19 @@ pub fn run(
                     message,
                 },
             );
+        }
+        // The rcl_interfaces parameter services; a change applies at once (the next output and cloud are
+        // placed on the new rates' grids).
+        let before = live;
+        param_srv.serve(&mut param_table, &mut live, &full_name, |m| {
+            log(ros2_client::ros2::LogLevel::Info, m)
+        })?;
+        if live != before {
+            let t = sim.time();
+            next_output = (t * live.output_rate_hz + 1e-9).floor() as u64 + 1;
+            if live.particles_rate_hz > 0.0 {
+                next_cloud = (t * live.particles_rate_hz + 1e-9).floor() as u64 + 1;
+            }
         }
         // 1. Drain the input (and what was fetched while stepping).
         let mut got = false;
@@ -1011,7 +1038,7 @@ pub fn run(
                 &full_name,
                 wall(),
                 &mut last_diag,
-                c.diagnostics_rate_hz,
+                live.diagnostics_rate_hz,
                 level_of("waiting for motion input", false, &counters),
                 || {
                     diagnostics(
@@ -1041,7 +1068,7 @@ pub fn run(
         // 2. No input for too long (real-time mode): hold the last pose, at rest, and say so.
         if c.realtime.mode == RealtimeMode::Realtime {
             if let (Some(age), Some(newest)) = (pacing.input_age(wall()), motion.newest()) {
-                if age > c.motion_timeout_s {
+                if age > live.motion_timeout_s {
                     if !holding {
                         holding = true;
                         counters.timeouts += 1;
@@ -1049,7 +1076,7 @@ pub fn run(
                             ros2_client::ros2::LogLevel::Error,
                             &format!(
                                 "{}: holding the last pose{}",
-                                no_input(&counters, age, c.motion_timeout_s),
+                                no_input(&counters, age, live.motion_timeout_s),
                                 buffered(last_real, sim.time())
                             ),
                         );
@@ -1120,7 +1147,7 @@ pub fn run(
                 if !std::mem::take(&mut initial) {
                     // Each step lands on the next output time (when the input reaches that far), so
                     // outputs are stamped on the output rate's grid whatever the step.
-                    if let Err(e) = sim.step_to(&motion, next_output as f64 / rate) {
+                    if let Err(e) = sim.step_to(&motion, next_output as f64 / live.output_rate_hz) {
                         error = Some(e.to_string());
                         break;
                     }
@@ -1147,7 +1174,7 @@ pub fn run(
                     }
                 }
                 let t = sim.time();
-                if t >= next_output as f64 / rate - 1e-9 {
+                if t >= next_output as f64 / live.output_rate_hz - 1e-9 {
                     let o = match sim.observe(&motion) {
                         Ok(o) => o,
                         Err(e) => {
@@ -1180,8 +1207,8 @@ pub fn run(
                         last_clock = Some(stamp);
                     }
                     counters.published += 1;
-                    if c.particles.rate_hz > 0.0
-                        && t >= next_cloud as f64 / c.particles.rate_hz - 1e-9
+                    if live.particles_rate_hz > 0.0
+                        && t >= next_cloud as f64 / live.particles_rate_hz - 1e-9
                     {
                         // The cloud is recorded even when only iceoryx2 publishes.
                         if pub_cloud.is_some() || recorder.is_some() {
@@ -1190,7 +1217,7 @@ pub fn run(
                                 &c.frames.tank,
                                 &sim.fluid_positions(),
                                 &sim.fluid_velocities(),
-                                c.particles.decimation,
+                                live.particles_decimation,
                             );
                             if let Some(r) = recorder.as_mut() {
                                 r.write(&cloud_topic, stamp, &cloud)?;
@@ -1202,12 +1229,12 @@ pub fn run(
                         if let (Some(p), true) = (iox_ports.as_mut(), iox.particles) {
                             p.publish_particles(base + o.time, &sim.snapshot())?;
                         }
-                        next_cloud = (t * c.particles.rate_hz + 1e-9).floor() as u64 + 1;
+                        next_cloud = (t * live.particles_rate_hz + 1e-9).floor() as u64 + 1;
                     }
-                    next_output = (t * rate + 1e-9).floor() as u64 + 1;
+                    next_output = (t * live.output_rate_hz + 1e-9).floor() as u64 + 1;
                 }
                 // Keep reading input and reporting while a long stretch is stepped.
-                if wall() - last_diag.wall > 1.0 / c.diagnostics_rate_hz {
+                if wall() - last_diag.wall > 1.0 / live.diagnostics_rate_hz {
                     break;
                 }
             }
@@ -1268,7 +1295,7 @@ pub fn run(
             &full_name,
             w,
             &mut last_diag,
-            c.diagnostics_rate_hz,
+            live.diagnostics_rate_hz,
             level_of(state, true, &counters),
             || {
                 diagnostics(
