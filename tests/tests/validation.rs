@@ -160,25 +160,28 @@ fn linear_forced_sway(t: f64, x_wall: f64, l: f64, h: f64, a: f64, period: f64) 
         .sum()
 }
 
+/// WCSPH reads an rms 1.30x the record's (its waves too high): it keeps the looser bound of 0.8-1.5, and
+/// fails the 0.85-1.15 the incompressible scheme meets.
 #[test]
 fn faltinsen_2000_forced_sway_elevation_near_the_wall() {
-    faltinsen_2000(&[], "faltinsen2000_sway", "WCSPH");
+    faltinsen_2000(&[], "faltinsen2000_sway", "WCSPH", 0.8..1.5);
 }
 
-/// The same comparison with the incompressible scheme (issue 5: everything validated for WCSPH holds for it).
+/// The same comparison with the incompressible scheme, whose rms is within 15 % of the record's.
 #[test]
 fn faltinsen_2000_forced_sway_elevation_near_the_wall_dfsph() {
     faltinsen_2000(
         &["solver.scheme=dfsph"],
         "faltinsen2000_sway_dfsph",
         "DFSPH",
+        0.85..1.15,
     );
 }
 
 /// Faltinsen et al. (2000), fig. 7: elevation 5 cm from the wall of a 1.73 m tank, 0.6 m deep, swayed
 /// 32 mm at 1.3 s, against linear theory (first 1.5 s) and the record (0–7 s), with `overrides` on top of
-/// dp 20 mm; draws the figure `name`.
-fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str) {
+/// dp 20 mm; draws the figure `name`. The simulated rms over the record's must lie in `rms_ratio`.
+fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str, rms_ratio: std::ops::Range<f64>) {
     let exp = table(&read(
         "faltinsen2000_sway/faltinsen_etal_2000_fig7_h0.6_T1.3.csv",
     ));
@@ -239,7 +242,10 @@ fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str) {
         ],
     );
     assert!(corr > 0.9, "correlation with the measured record {corr}");
-    assert!((0.8..1.5).contains(&ratio), "rms ratio {ratio}");
+    assert!(
+        rms_ratio.contains(&ratio),
+        "rms ratio {ratio}, bounds {rms_ratio:?}"
+    );
 }
 
 #[test]
