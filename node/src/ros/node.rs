@@ -968,6 +968,8 @@ pub fn run(
                             motion = fresh_motion();
                             rebase = true;
                             newest_stamp = None;
+                            // They were not refused after all: counted again as they are taken.
+                            counters.rejected -= other_base.len() as u64;
                             for item in other_base.drain(..).rev() {
                                 incoming.push_front(item);
                             }

@@ -1,0 +1,331 @@
+//! A soak that loses nothing: `slosh node` in lockstep, recording a bag, driven through `SLOSH_SOAK_SECONDS`
+//! (60 in the test command) of motion at 50 Hz by a publisher that injects faults every 20 s of stamps —
+//! a burst (25 samples back to back), duplicates (every sample of a second sent twice), reordering (pairs
+//! swapped), a jump of the stamps past `input.max_gap_s` (the input on a new time base), the publisher
+//! restarted (a new DDS writer) — beside a reliable subscriber of the outputs that never reads, and ended
+//! by SIGINT while the node works. Passes when the node exits cleanly; every motion sample it took (accepted
+//! or refused) is in the bag, and every output it published; the bag reads with rosbags and mcap; its
+//! resident memory is flat after the first fifth of the run. The figures go to stdout. The hour:
+//!
+//!     SLOSH_SOAK_SECONDS=3600 cargo test --release -p slosh-node --test soak -- --nocapture
+
+mod common;
+
+use common::slosh;
+use ros2_client::qos::{History, WhenFull};
+use ros2_client::{
+    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
+};
+use slosh_msgs::builtin_interfaces::Time;
+use slosh_msgs::geometry_msgs::{
+    Pose, PoseWithCovariance, Quaternion, TwistWithCovariance, WrenchStamped,
+};
+use slosh_msgs::nav_msgs::Odometry;
+use slosh_msgs::rosgraph_msgs::Clock;
+use slosh_msgs::std_msgs::Header;
+use slosh_msgs::RosMessage;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const RATE: f64 = 50.0;
+const NS: &str = "/soak";
+const T0: f64 = 5000.0;
+
+fn topic<M: RosMessage>(
+    node: &mut ros2_client::Node,
+    name: &str,
+    qos: &QosProfile,
+) -> ros2_client::dds::rustdds::Topic {
+    let (ns, base) = name.rsplit_once('/').unwrap();
+    node.create_topic(
+        &Name::new(if ns.is_empty() { "/" } else { ns }, base).unwrap(),
+        MessageTypeName::new(M::PACKAGE, M::NAME),
+        qos,
+    )
+    .unwrap()
+}
+
+/// A swaying vessel at time `t` (s of motion), stamped `stamp`.
+fn odometry(t: f64, stamp: f64) -> Odometry {
+    let mut pose = Pose {
+        orientation: Quaternion::identity(),
+        ..Default::default()
+    };
+    pose.position.x = 0.02 * (2.0 * std::f64::consts::PI * t / 1.3).sin();
+    Odometry {
+        header: Header {
+            stamp: Time::from_secs_f64(stamp),
+            frame_id: "odom".into(),
+        },
+        child_frame_id: "base_link".into(),
+        pose: PoseWithCovariance {
+            pose,
+            covariance: [0.0; 36],
+        },
+        twist: TwistWithCovariance::default(),
+    }
+}
+
+/// Resident memory of process `pid`, kB.
+fn rss_kb(pid: u32) -> Option<u64> {
+    let s = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    s.lines()
+        .find(|l| l.starts_with("VmRSS:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()
+}
+
+/// `what: N` counted in the node's stop line.
+fn count(log: &str, what: &str) -> u64 {
+    let line = log
+        .lines()
+        .find(|l| l.contains("stopping at t ="))
+        .unwrap_or_else(|| panic!("no stop line in the log:\n{log}"));
+    let at = line
+        .find(what)
+        .unwrap_or_else(|| panic!("{what} in {line}"));
+    line[..at]
+        .split_whitespace()
+        .last()
+        .unwrap()
+        .trim_start_matches([',', ':'])
+        .parse()
+        .unwrap_or_else(|e| panic!("{e}: {line}"))
+}
+
+struct Kill(Child);
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn an_hour_of_faulty_motion_loses_nothing() {
+    if !common::in_private_netns("an_hour_of_faulty_motion_loses_nothing") {
+        return;
+    }
+    let seconds: f64 = std::env::var("SLOSH_SOAK_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(60.0);
+    let dir = common::tmp("soak");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, common::small_case_at(0.04, "")).unwrap();
+    let bag = dir.join("bag");
+    let domain = 61u16;
+    let mut proc = Kill(
+        slosh()
+            .args(["node", "--ros-args", "--params-file"])
+            .arg(&case)
+            .args([
+                "-r",
+                &format!("__ns:={NS}"),
+                "-p",
+                "realtime.mode:=lockstep",
+            ])
+            .args(["-p", "output_rate_hz:=20.0", "-p"])
+            .arg(format!("record.path:={}", bag.display()))
+            .env("ROS_DOMAIN_ID", domain.to_string())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let pid = proc.0.id();
+
+    let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
+    let mut node = ctx
+        .new_node(
+            NodeName::new("/", "soak_driver").unwrap(),
+            NodeOptions::new().enable_rosout(false),
+        )
+        .unwrap();
+    let odom_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 50 });
+    let odom_topic = topic::<Odometry>(&mut node, &format!("{NS}/motion/odom"), &odom_qos);
+    let mut publisher = node
+        .create_publisher::<Odometry>(&odom_topic, Some(odom_qos.clone()))
+        .unwrap();
+    let clock_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 1 });
+    let clock_topic = topic::<Clock>(&mut node, "/clock", &clock_qos);
+    let clock = node
+        .create_subscription::<Clock>(&clock_topic, Some(clock_qos))
+        .unwrap();
+    // A reliable reader of the wrench that never reads: the node must not wait for it.
+    let stall_qos = QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::Wait(Duration::from_millis(100)))
+        .history(History::KeepLast { depth: 1 });
+    let stall_topic = topic::<WrenchStamped>(&mut node, &format!("{NS}/wrench"), &stall_qos);
+    let _stalled = node
+        .create_subscription::<WrenchStamped>(&stall_topic, Some(stall_qos))
+        .unwrap();
+    let seen = Instant::now();
+    while node.subscription_count(&format!("{NS}/motion/odom")) == 0 {
+        assert!(
+            seen.elapsed() < Duration::from_secs(30),
+            "the node never subscribed"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+
+    // The samples to send: (motion time, stamp), faults included.
+    let n = (seconds * RATE) as usize;
+    let mut plan: Vec<(f64, f64, bool)> = Vec::with_capacity(n + n / 10);
+    let mut jump = 0.0;
+    let (mut bursts, mut duplicated, mut swapped, mut jumps, mut restarts) = (0, 0, 0, 0, 0);
+    let mut k = 0;
+    while k <= n {
+        let t = k as f64 / RATE;
+        let second = k / RATE as usize;
+        let phase = second % 20;
+        let first_of_second = k % RATE as usize == 0;
+        if phase == 12 && first_of_second {
+            // The stamps jump 6 s ahead (past input.max_gap_s = 5 s): a new time base.
+            jump += 6.0;
+            jumps += 1;
+        }
+        let stamp = T0 + t + jump;
+        match phase {
+            6 => {
+                plan.push((t, stamp, false));
+                plan.push((t, stamp, false));
+                duplicated += 1;
+            }
+            9 if k % 2 == 0 && k < n => {
+                let t2 = (k + 1) as f64 / RATE;
+                plan.push((t2, T0 + t2 + jump, false));
+                plan.push((t, stamp, false));
+                swapped += 1;
+                k += 1;
+            }
+            // A burst: this second's first 25 samples go out back to back (no pacing).
+            3 if k % RATE as usize == 0 => {
+                for j in 0..25 {
+                    let tj = (k + j) as f64 / RATE;
+                    plan.push((tj, T0 + tj + jump, true));
+                }
+                bursts += 1;
+                k += 24;
+            }
+            15 if first_of_second => {
+                // Marks a restart before this sample (a negative motion time, read below).
+                plan.push((-1.0, 0.0, false));
+                plan.push((t, stamp, false));
+                restarts += 1;
+            }
+            _ => plan.push((t, stamp, false)),
+        }
+        k += 1;
+    }
+
+    let mut rss: Vec<(f64, u64)> = vec![];
+    let start = Instant::now();
+    let mut last_rss = Instant::now() - Duration::from_secs(10);
+    let mut clock_stamp = f64::NEG_INFINITY;
+    let mut sent = 0u64;
+    for &(t, stamp, burst) in &plan {
+        if t < 0.0 {
+            // The publisher restarted: a new writer (a new GUID) on the same topic.
+            drop(publisher);
+            publisher = node
+                .create_publisher::<Odometry>(&odom_topic, Some(odom_qos.clone()))
+                .unwrap();
+            // (Time for the node's reader to match the new writer.)
+            std::thread::sleep(Duration::from_millis(300));
+            continue;
+        }
+        // Lockstep: stay at most a few samples ahead of the node's /clock (it reads the stamps of the
+        // simulation on the input's time base); a node that rejects the samples does not move it, so the
+        // wait is bounded.
+        if !burst {
+            let waited = Instant::now();
+            while clock_stamp < stamp - 6.0 / RATE && waited.elapsed() < Duration::from_millis(300)
+            {
+                while let Ok(Some((c, _))) = clock.take() {
+                    clock_stamp = c.clock.as_secs_f64();
+                }
+                std::thread::sleep(Duration::from_micros(200));
+            }
+        }
+        publisher.publish(odometry(t, stamp)).unwrap();
+        sent += 1;
+        if last_rss.elapsed() >= Duration::from_secs(1) {
+            last_rss = Instant::now();
+            if let Some(kb) = rss_kb(pid) {
+                rss.push((start.elapsed().as_secs_f64(), kb));
+            }
+        }
+    }
+    // SIGINT while the node is still stepping and writing.
+    assert!(Command::new("kill")
+        .args(["-INT", &pid.to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let mut log = String::new();
+    if let Some(mut e) = proc.0.stderr.take() {
+        std::io::Read::read_to_string(&mut e, &mut log).unwrap();
+    }
+    let status = proc.0.wait().unwrap();
+    assert!(status.success(), "{status}: {log}");
+    let wall = start.elapsed().as_secs_f64();
+    let (accepted, rejected, published) = (
+        count(&log, "samples accepted"),
+        count(&log, "rejected"),
+        count(&log, "outputs published"),
+    );
+
+    let read = common::read_bag(&bag);
+    let in_bag = |reader: &str, name: &str| {
+        read[reader][name]["items"]
+            .as_array()
+            .map_or(0, |v| v.len() as u64)
+    };
+    let odom = format!("{NS}/motion/odom");
+    let wrench = format!("{NS}/wrench");
+    println!(
+        "soak: {seconds} s of motion in {wall:.1} s wall: {sent} samples sent ({bursts} bursts, {duplicated} samples sent twice, {swapped} pairs swapped, {jumps} stamp jumps, {restarts} publisher restarts); the node took {accepted} and refused {rejected}, published {published} outputs; the bag holds {} motion samples and {} wrenches",
+        in_bag("rosbags", &odom),
+        in_bag("rosbags", &wrench)
+    );
+    println!("soak: resident memory (s, kB): {rss:?}");
+    // Every sample the node took, accepted or refused, is in the bag; every output it published.
+    for reader in ["rosbags", "mcap"] {
+        assert_eq!(
+            in_bag(reader, &odom),
+            accepted + rejected,
+            "{reader}: motion samples"
+        );
+        assert_eq!(in_bag(reader, &wrench), published, "{reader}: wrenches");
+    }
+    // The faults were met: duplicates, swapped pairs and the time-base jumps are refused, not lost.
+    assert!(rejected >= duplicated as u64, "{rejected} refused");
+    assert!(
+        accepted + rejected <= sent && accepted > sent * 8 / 10,
+        "{accepted} of {sent}"
+    );
+    assert!(
+        published as f64 >= 0.9 * seconds * 20.0,
+        "{published} outputs"
+    );
+    // Memory flat after the first fifth of the run: no more than 10 % (and 4 MB) above its level there.
+    let settled = rss
+        .iter()
+        .find(|(t, _)| *t >= 0.2 * wall)
+        .map(|r| r.1)
+        .expect("memory samples");
+    let peak = rss
+        .iter()
+        .filter(|(t, _)| *t >= 0.2 * wall)
+        .map(|r| r.1)
+        .max()
+        .unwrap();
+    assert!(
+        peak as f64 <= settled as f64 * 1.1 + 4096.0,
+        "resident memory grew from {settled} kB to {peak} kB: {rss:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
