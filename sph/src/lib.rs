@@ -49,6 +49,7 @@ pub mod domain;
 pub mod eos;
 pub mod error;
 pub mod fast;
+pub mod flooding;
 pub mod integrate;
 pub mod kernel;
 pub mod motion;

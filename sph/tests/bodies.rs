@@ -4,8 +4,8 @@
 
 use sph::body::BodyState;
 use sph::motion::AtRest;
+use sph::params::BodySpec;
 use sph::params::*;
-use sph::params::{BodySpec, Dof, RegionSpec};
 use sph::Solver;
 
 mod common;
@@ -184,53 +184,30 @@ fn water_pours_in_by_the_orifice_law_with_the_incompressible_scheme_too() {
 /// The box held at its draught, a hole 20 mm wide through the middle of its bottom, dry inside.
 fn orifice(scheme: Scheme) {
     println!("{scheme:?}:");
-    let draught = 0.15;
-    let width = 0.02;
-    let mut spec = floating_box(draught, 0.05, 0.147);
-    spec.fixed = Dof::ALL.to_vec();
-    spec.openings.push(RegionSpec {
-        name: "bottom".into(),
-        centre: [0.0, 0.0, 0.5 * WALL],
-        size: [width, 1.0, 2.0 * WALL],
-    });
-    let every = 0.02;
-    let mut p = basin(vec![spec]);
-    p.solver.scheme = scheme;
-    let (sim, rows) = run(p, 0.6, every);
-    assert_eq!(sim.counts().lost, 0);
-    let floor = DEPTH - draught + WALL;
-    let inner = B - 2.0 * WALL;
-    // Head across the hole: the basin's level (far probe) over the level inside (its volume over its width).
-    let head = |r: &Row| r.1 - (floor + r.2.flooded_volume / inner);
-    let mut cds = Vec::new();
-    // Discharge over windows of 0.1 s once the jet is established.
-    let w = (0.1 / every).round() as usize;
-    let mut i = (0.1 / every).round() as usize;
-    while i + w < rows.len() {
-        let (a, b) = (&rows[i], &rows[i + w]);
-        let q = (b.2.flooded_volume - a.2.flooded_volume) / (b.0 - a.0);
-        let dh = 0.5 * (head(a) + head(b));
-        let cd = q / (width * (2.0 * G * dh).sqrt());
+    // The slot 4 spacings (20 mm) wide.
+    let p = sph::flooding::case(scheme, 4.0, DP);
+    let d = sph::flooding::discharge(p, 0.6, 0.02, (0.1, 0.1)).expect("runs");
+    assert_eq!(d.lost, 0);
+    for w in &d.windows {
         println!(
-            "t {:.2}–{:.2} s: head {dh:.4} m, inflow {q:.5} m²/s, Cd {cd:.3}",
-            a.0, b.0
+            "t {:.2}–{:.2} s: head {:.4} m, inflow {:.5} m²/s, Cd {:.3}",
+            w.from, w.to, w.head, w.inflow, w.cd
         );
-        cds.push(cd);
-        i += w;
     }
     // The reported inflow rates integrate to the flooded volume.
     let mut integral = 0.0;
     let mut t0 = 0.0;
-    for r in &rows {
-        integral += r.2.inflow_rate * (r.0 - t0);
-        t0 = r.0;
+    for s in &d.samples {
+        integral += s.body.inflow_rate * (s.time - t0);
+        t0 = s.time;
     }
-    let v_end = rows.last().unwrap().2.flooded_volume;
+    let v_end = d.samples.last().unwrap().body.flooded_volume;
     assert!((integral - v_end).abs() < 1e-9, "{integral} vs {v_end}");
     assert!(v_end > 0.0);
     // A plausible discharge coefficient (a sharp-edged slot contracts to π/(π+2) = 0.61 of its width; this
     // one is a short channel 4 dp wide whose wall particles hold the liquid a little off) that holds as the
     // head falls (Q ∝ √Δh).
+    let cds: Vec<f64> = d.windows.iter().map(|w| w.cd).collect();
     for &cd in &cds {
         assert!(cd > 0.4 && cd < 0.9, "Cd {cd}");
     }
