@@ -15,46 +15,13 @@ fn cyclonedds_peer_drives_the_node_and_reads_its_outputs() {
         "ros-peer",
         "    pressure_sensors: {names: [bottom], x: [0.0], y: [0.0], z: [0.0]}\n",
     );
-    let domain = "23";
-    let mut node = common::slosh()
-        .args(["node", "--duration", "2.0", "--ros-args", "--params-file"])
-        .arg(&case)
-        .args(["-r", "__ns:=/peer", "-p", "realtime.mode:=lockstep"])
-        .args(["-p", "particles:={rate_hz: 5.0, decimation: 4}"])
-        .env("ROS_DOMAIN_ID", domain)
-        .spawn()
-        .unwrap();
-    let script = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../tests/py/peer_cyclonedds.py"
+    let v = node_and_peer(
+        &case,
+        "23",
+        &["-p", "particles:={rate_hz: 5.0, decimation: 4}"],
+        &[],
     );
-    let out = Command::new(common::python())
-        .arg(script)
-        .args([
-            "--domain",
-            domain,
-            "--ns",
-            "/peer",
-            "--seconds",
-            "3",
-            "--t0",
-            "2000",
-        ])
-        .stderr(Stdio::inherit())
-        .output()
-        .unwrap();
-    let _ = node.kill();
-    let node_status = node.wait().unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "the cyclonedds peer failed: {text}");
-    let v: serde_json::Value =
-        serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"));
     println!("peer saw: {}", v["counts"]);
-    assert!(v.get("error").is_none(), "{}", v["error"]);
-    assert!(
-        node_status.success() || node_status.code().is_none(),
-        "slosh node failed: {node_status}"
-    );
 
     // Counts: 2 s at 20 Hz of each output, all received by the reliable peer.
     for k in ["wrench", "probes", "pressures"] {
@@ -147,31 +114,7 @@ fn cyclonedds_peer_lists_gets_and_sets_the_node_parameters() {
         return;
     }
     let (dir, case) = common::case_dir("ros-peer-params", "");
-    let domain = "24";
-    let mut node = common::slosh()
-        .args(["node", "--duration", "3.0", "--ros-args", "--params-file"])
-        .arg(&case)
-        .args(["-r", "__ns:=/peer", "-p", "realtime.mode:=lockstep"])
-        .env("ROS_DOMAIN_ID", domain)
-        .spawn()
-        .unwrap();
-    let script = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../tests/py/peer_cyclonedds.py"
-    );
-    let out = Command::new(common::python())
-        .arg(script)
-        .args(["--domain", domain, "--ns", "/peer", "--seconds", "3"])
-        .args(["--t0", "2000", "--parameters", "slosh"])
-        .stderr(Stdio::inherit())
-        .output()
-        .unwrap();
-    let _ = node.kill();
-    let _ = node.wait();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "the cyclonedds peer failed: {text}");
-    let v: serde_json::Value =
-        serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"));
+    let v = node_and_peer(&case, "24", &[], &["--parameters", "slosh"]);
     let p = &v["parameters"];
     let listed: Vec<&str> = p["list"]
         .as_array()
@@ -271,4 +214,47 @@ fn cyclonedds_peer_lists_gets_and_sets_the_node_parameters() {
         "{events:?}"
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Runs `slosh node` on `case` (namespace /peer, lockstep, 2 simulated seconds, `node_args` added to its ROS
+/// arguments) in DDS domain `domain` and the Python peer beside it (3 s of motion from stamp 2000, `peer_args`
+/// added); what the peer printed, once both have ended well.
+fn node_and_peer(
+    case: &std::path::Path,
+    domain: &str,
+    node_args: &[&str],
+    peer_args: &[&str],
+) -> serde_json::Value {
+    let mut node = common::slosh()
+        .args(["node", "--duration", "2.0", "--ros-args", "--params-file"])
+        .arg(case)
+        .args(["-r", "__ns:=/peer", "-p", "realtime.mode:=lockstep"])
+        .args(node_args)
+        .env("ROS_DOMAIN_ID", domain)
+        .spawn()
+        .unwrap();
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/py/peer_cyclonedds.py"
+    );
+    let out = Command::new(common::python())
+        .arg(script)
+        .args(["--domain", domain, "--ns", "/peer", "--seconds", "3"])
+        .args(["--t0", "2000"])
+        .args(peer_args)
+        .stderr(Stdio::inherit())
+        .output()
+        .unwrap();
+    let _ = node.kill();
+    let node_status = node.wait().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "the cyclonedds peer failed: {text}");
+    let v: serde_json::Value =
+        serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"));
+    assert!(v.get("error").is_none(), "{}", v["error"]);
+    assert!(
+        node_status.success() || node_status.code().is_none(),
+        "slosh node failed: {node_status}"
+    );
+    v
 }
