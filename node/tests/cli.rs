@@ -671,3 +671,33 @@ fn the_readme_s_commands_run() {
     assert!(commands >= 10, "{commands} commands in the README's table");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// ROS 2's security variables asking to enforce SROS2, which this build cannot: the node and the motion
+/// publisher refuse to start (before joining any DDS domain), naming the variables and the ways out.
+#[test]
+fn enforced_ros_security_is_refused_before_joining_the_graph() {
+    // (In a loopback-only namespace all the same: were the refusal to fail, the node would join a domain.)
+    if !common::in_private_netns("enforced_ros_security_is_refused_before_joining_the_graph") {
+        return;
+    }
+    for args in [
+        vec!["node", "--duration", "1", "seed_tank_039"],
+        vec!["motion", "seed_tank_039", "--duration", "1"],
+    ] {
+        let o = slosh()
+            .args(&args)
+            .env("ROS_SECURITY_ENABLE", "true")
+            .env("ROS_SECURITY_STRATEGY", "Enforce")
+            .env("ROS_SECURITY_KEYSTORE", "/nonexistent/keystore")
+            .output()
+            .unwrap();
+        assert!(!o.status.success(), "{args:?} started");
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            e.contains("ROS_SECURITY_STRATEGY=Enforce")
+                && e.contains("/nonexistent/keystore")
+                && e.contains("no DDS-Security"),
+            "{args:?}: {e}"
+        );
+    }
+}

@@ -24,8 +24,35 @@ pub fn domain_id() -> anyhow::Result<u16> {
     }
 }
 
-/// A DDS context on the domain of `ROS_DOMAIN_ID`.
+/// What ROS 2's security variables ask of a participant, read as rcl reads them: `ROS_SECURITY_ENABLE` must be
+/// exactly `true` to ask for DDS-Security (SROS2), and `ROS_SECURITY_STRATEGY` `Enforce` makes a participant that
+/// cannot be secured fail instead of joining unsecured (anything else is Permissive). This build of `slosh` has
+/// no DDS-Security: asked to enforce it, it refuses to start (it would otherwise join the graph
+/// unauthenticated and unencrypted); asked permissively, it starts unsecured with a warning, as a Permissive
+/// rcl participant without its keystore files does. `env` reads a variable.
+pub fn security(env: impl Fn(&str) -> Option<String>) -> anyhow::Result<Option<String>> {
+    if env("ROS_SECURITY_ENABLE").as_deref() != Some("true") {
+        return Ok(None);
+    }
+    let keystore = env("ROS_SECURITY_KEYSTORE").unwrap_or_else(|| "(unset)".into());
+    if env("ROS_SECURITY_STRATEGY").as_deref() == Some("Enforce") {
+        anyhow::bail!(
+            "ROS_SECURITY_ENABLE=true with ROS_SECURITY_STRATEGY=Enforce (keystore {keystore}): this slosh has no \
+             DDS-Security (SROS2) support, so it cannot join a secured ROS 2 graph; run it on an unsecured \
+             domain (unset ROS_SECURITY_ENABLE) or set ROS_SECURITY_STRATEGY=Permissive to join unsecured"
+        );
+    }
+    Ok(Some(format!(
+        "ROS_SECURITY_ENABLE=true (Permissive; keystore {keystore}): this slosh has no DDS-Security (SROS2) \
+         support: it joins the graph unauthenticated and unencrypted, and secured participants will not talk to it"
+    )))
+}
+
+/// A DDS context on the domain of `ROS_DOMAIN_ID` (after [`security`]: its warning goes to stderr).
 pub fn context() -> anyhow::Result<Context> {
+    if let Some(warning) = security(|k| std::env::var(k).ok())? {
+        eprintln!("slosh: {warning}");
+    }
     let d = domain_id()?;
     Context::with_options(ContextOptions::new().domain_id(d))
         .map_err(|e| anyhow::anyhow!("cannot start DDS on domain {d}: {e:?}"))
@@ -86,5 +113,65 @@ pub fn publish<M: serde::Serialize + std::fmt::Debug>(
     match p.publish(m) {
         Ok(()) | Err(ros2_client::WriteError::WouldBlock { .. }) => Ok(()),
         Err(e) => Err(anyhow::anyhow!("publishing {what}: {e:?}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::security;
+
+    fn env(vars: &'static [(&'static str, &'static str)]) -> impl Fn(&str) -> Option<String> {
+        move |k| {
+            vars.iter()
+                .find(|(n, _)| *n == k)
+                .map(|(_, v)| v.to_string())
+        }
+    }
+
+    #[test]
+    fn security_variables_are_read_as_rcl_reads_them() {
+        // Not enabled: nothing to say (only the exact "true" enables it).
+        assert!(security(env(&[])).unwrap().is_none());
+        assert!(security(env(&[("ROS_SECURITY_ENABLE", "1")]))
+            .unwrap()
+            .is_none());
+        assert!(security(env(&[
+            ("ROS_SECURITY_ENABLE", "True"),
+            ("ROS_SECURITY_STRATEGY", "Enforce")
+        ]))
+        .unwrap()
+        .is_none());
+        // Enforce: refused, naming the variables, the keystore and the ways out.
+        let e = security(env(&[
+            ("ROS_SECURITY_ENABLE", "true"),
+            ("ROS_SECURITY_STRATEGY", "Enforce"),
+            ("ROS_SECURITY_KEYSTORE", "/ks"),
+        ]))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("ROS_SECURITY_STRATEGY=Enforce")
+                && e.contains("/ks")
+                && e.contains("unset ROS_SECURITY_ENABLE")
+                && e.contains("Permissive"),
+            "{e}"
+        );
+        // Permissive (or anything but Enforce): a warning.
+        for strategy in ["Permissive", "enforce", ""] {
+            let w = security(env(match strategy {
+                "Permissive" => &[
+                    ("ROS_SECURITY_ENABLE", "true"),
+                    ("ROS_SECURITY_STRATEGY", "Permissive"),
+                ],
+                "enforce" => &[
+                    ("ROS_SECURITY_ENABLE", "true"),
+                    ("ROS_SECURITY_STRATEGY", "enforce"),
+                ],
+                _ => &[("ROS_SECURITY_ENABLE", "true")],
+            }))
+            .unwrap()
+            .unwrap();
+            assert!(w.contains("unauthenticated and unencrypted"), "{w}");
+        }
     }
 }
