@@ -672,12 +672,12 @@ fn the_readme_s_commands_run() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
-/// ROS 2's security variables asking to enforce SROS2, which this build cannot: the node and the motion
-/// publisher refuse to start (before joining any DDS domain), naming the variables and the ways out.
+/// SROS2 enforced without its keystore: the node and the motion publisher stop at start-up (before joining
+/// any DDS domain), naming the missing file and the fix.
 #[test]
-fn enforced_ros_security_is_refused_before_joining_the_graph() {
+fn enforced_ros_security_without_its_keystore_stops_at_start_up() {
     // (In a loopback-only namespace all the same: were the refusal to fail, the node would join a domain.)
-    if !common::in_private_netns("enforced_ros_security_is_refused_before_joining_the_graph") {
+    if !common::in_private_netns("enforced_ros_security_without_its_keystore_stops_at_start_up") {
         return;
     }
     for args in [
@@ -689,14 +689,17 @@ fn enforced_ros_security_is_refused_before_joining_the_graph() {
             .env("ROS_SECURITY_ENABLE", "true")
             .env("ROS_SECURITY_STRATEGY", "Enforce")
             .env("ROS_SECURITY_KEYSTORE", "/nonexistent/keystore")
+            .env("ROS_SECURITY_ENCLAVE_OVERRIDE", "/ship/tank")
             .output()
             .unwrap();
         assert!(!o.status.success(), "{args:?} started");
         let e = String::from_utf8_lossy(&o.stderr);
         assert!(
             e.contains("ROS_SECURITY_STRATEGY=Enforce")
-                && e.contains("/nonexistent/keystore")
-                && e.contains("no DDS-Security"),
+                && e.contains(
+                    "/nonexistent/keystore/enclaves/ship/tank/identity_ca.cert.pem is missing"
+                )
+                && e.contains("ros2 security create_enclave"),
             "{args:?}: {e}"
         );
     }

@@ -24,38 +24,84 @@ pub fn domain_id() -> anyhow::Result<u16> {
     }
 }
 
-/// What ROS 2's security variables ask of a participant, read as rcl reads them: `ROS_SECURITY_ENABLE` must be
-/// exactly `true` to ask for DDS-Security (SROS2), and `ROS_SECURITY_STRATEGY` `Enforce` makes a participant that
-/// cannot be secured fail instead of joining unsecured (anything else is Permissive). This build of `slosh` has
-/// no DDS-Security: asked to enforce it, it refuses to start (it would otherwise join the graph
-/// unauthenticated and unencrypted); asked permissively, it starts unsecured with a warning, as a Permissive
-/// rcl participant without its keystore files does. `env` reads a variable.
-pub fn security(env: impl Fn(&str) -> Option<String>) -> anyhow::Result<Option<String>> {
+/// The files of an SROS2 enclave (`ros2 security create_enclave KEYSTORE ENCLAVE` makes them).
+pub const ENCLAVE_FILES: [&str; 6] = [
+    "identity_ca.cert.pem",
+    "cert.pem",
+    "key.pem",
+    "permissions_ca.cert.pem",
+    "governance.p7s",
+    "permissions.p7s",
+];
+
+/// How a participant joins, from ROS 2's security variables.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Security {
+    /// `ROS_SECURITY_ENABLE` is not `true`.
+    Off,
+    /// Secured with the enclave's files in this folder.
+    Enclave(std::path::PathBuf),
+    /// Asked for, but the enclave is not there and the strategy is Permissive: unsecured, with this warning.
+    Unsecured(String),
+}
+
+/// Reads ROS 2's security variables as rcl reads them: `ROS_SECURITY_ENABLE` must be exactly `true`;
+/// the enclave is `ROS_SECURITY_ENCLAVE_OVERRIDE` (else `/`), its files in
+/// `ROS_SECURITY_KEYSTORE/enclaves/<enclave>`; with `ROS_SECURITY_STRATEGY=Enforce` a missing keystore or
+/// file is an error naming it and the fix, otherwise (Permissive) the participant joins unsecured and says
+/// so. `env` reads a variable.
+pub fn security(env: impl Fn(&str) -> Option<String>) -> anyhow::Result<Security> {
     if env("ROS_SECURITY_ENABLE").as_deref() != Some("true") {
-        return Ok(None);
+        return Ok(Security::Off);
     }
-    let keystore = env("ROS_SECURITY_KEYSTORE").unwrap_or_else(|| "(unset)".into());
-    if env("ROS_SECURITY_STRATEGY").as_deref() == Some("Enforce") {
-        anyhow::bail!(
-            "ROS_SECURITY_ENABLE=true with ROS_SECURITY_STRATEGY=Enforce (keystore {keystore}): this slosh has no \
-             DDS-Security (SROS2) support, so it cannot join a secured ROS 2 graph; run it on an unsecured \
-             domain (unset ROS_SECURITY_ENABLE) or set ROS_SECURITY_STRATEGY=Permissive to join unsecured"
-        );
+    let enforce = env("ROS_SECURITY_STRATEGY").as_deref() == Some("Enforce");
+    let enclave = env("ROS_SECURITY_ENCLAVE_OVERRIDE").unwrap_or_else(|| "/".into());
+    let missing = match env("ROS_SECURITY_KEYSTORE").filter(|k| !k.is_empty()) {
+        None => "ROS_SECURITY_KEYSTORE is not set".to_string(),
+        Some(keystore) => {
+            let dir = std::path::Path::new(&keystore)
+                .join("enclaves")
+                .join(enclave.trim_start_matches('/'));
+            match ENCLAVE_FILES.iter().find(|f| !dir.join(f).is_file()) {
+                None => return Ok(Security::Enclave(dir)),
+                Some(f) => format!(
+                    "{} is missing (enclave {enclave} of keystore {keystore})",
+                    dir.join(f).display()
+                ),
+            }
+        }
+    };
+    let fix = format!(
+        "make the enclave with `ros2 security create_enclave KEYSTORE {enclave}` and set ROS_SECURITY_KEYSTORE \
+         (ROS_SECURITY_ENCLAVE_OVERRIDE names another enclave)"
+    );
+    if enforce {
+        anyhow::bail!("ROS_SECURITY_ENABLE=true, ROS_SECURITY_STRATEGY=Enforce: {missing}: {fix}");
     }
-    Ok(Some(format!(
-        "ROS_SECURITY_ENABLE=true (Permissive; keystore {keystore}): this slosh has no DDS-Security (SROS2) \
-         support: it joins the graph unauthenticated and unencrypted, and secured participants will not talk to it"
+    Ok(Security::Unsecured(format!(
+        "ROS_SECURITY_ENABLE=true (Permissive): {missing}: joining unsecured (unauthenticated and \
+         unencrypted; secured participants will not talk to this one); to secure it, {fix}"
     )))
 }
 
-/// A DDS context on the domain of `ROS_DOMAIN_ID` (after [`security`]: its warning goes to stderr).
+/// A DDS context on the domain of `ROS_DOMAIN_ID`, secured as [`security`] says (its warning goes to stderr).
 pub fn context() -> anyhow::Result<Context> {
-    if let Some(warning) = security(|k| std::env::var(k).ok())? {
-        eprintln!("slosh: {warning}");
-    }
+    let sec = security(|k| std::env::var(k).ok())?;
     let d = domain_id()?;
-    Context::with_options(ContextOptions::new().domain_id(d))
-        .map_err(|e| anyhow::anyhow!("cannot start DDS on domain {d}: {e:?}"))
+    let mut options = ContextOptions::new().domain_id(d);
+    match &sec {
+        Security::Off => {}
+        Security::Unsecured(warning) => eprintln!("slosh: {warning}"),
+        // SROS2's keys are not password-protected.
+        Security::Enclave(dir) => options = options.enable_security(dir, String::new()),
+    }
+    Context::with_options(options).map_err(|e| match &sec {
+        Security::Enclave(dir) => anyhow::anyhow!(
+            "cannot start secured DDS on domain {d} with the enclave in {}: {e:?}",
+            dir.display()
+        ),
+        _ => anyhow::anyhow!("cannot start DDS on domain {d}: {e:?}"),
+    })
 }
 
 /// The ros2-client name of a resolved topic name.
@@ -118,60 +164,65 @@ pub fn publish<M: serde::Serialize + std::fmt::Debug>(
 
 #[cfg(test)]
 mod tests {
-    use super::security;
+    use super::{security, Security, ENCLAVE_FILES};
 
-    fn env(vars: &'static [(&'static str, &'static str)]) -> impl Fn(&str) -> Option<String> {
-        move |k| {
-            vars.iter()
-                .find(|(n, _)| *n == k)
-                .map(|(_, v)| v.to_string())
-        }
+    fn env(vars: Vec<(&'static str, String)>) -> impl Fn(&str) -> Option<String> {
+        move |k| vars.iter().find(|(n, _)| *n == k).map(|(_, v)| v.clone())
     }
 
     #[test]
     fn security_variables_are_read_as_rcl_reads_them() {
-        // Not enabled: nothing to say (only the exact "true" enables it).
-        assert!(security(env(&[])).unwrap().is_none());
-        assert!(security(env(&[("ROS_SECURITY_ENABLE", "1")]))
-            .unwrap()
-            .is_none());
-        assert!(security(env(&[
-            ("ROS_SECURITY_ENABLE", "True"),
-            ("ROS_SECURITY_STRATEGY", "Enforce")
-        ]))
-        .unwrap()
-        .is_none());
-        // Enforce: refused, naming the variables, the keystore and the ways out.
-        let e = security(env(&[
-            ("ROS_SECURITY_ENABLE", "true"),
-            ("ROS_SECURITY_STRATEGY", "Enforce"),
-            ("ROS_SECURITY_KEYSTORE", "/ks"),
-        ]))
-        .unwrap_err()
-        .to_string();
+        let on = |more: Vec<(&'static str, String)>| {
+            let mut v = vec![("ROS_SECURITY_ENABLE", "true".to_string())];
+            v.extend(more);
+            v
+        };
+        // Not enabled (only the exact "true" enables it).
+        assert_eq!(security(env(vec![])).unwrap(), Security::Off);
+        let not = vec![
+            ("ROS_SECURITY_ENABLE", "True".to_string()),
+            ("ROS_SECURITY_STRATEGY", "Enforce".to_string()),
+        ];
+        assert_eq!(security(env(not)).unwrap(), Security::Off);
+        // Enforce without a keystore, or with an enclave missing a file: refused, naming what and the fix.
+        let e = security(env(on(vec![("ROS_SECURITY_STRATEGY", "Enforce".into())])))
+            .unwrap_err()
+            .to_string();
         assert!(
-            e.contains("ROS_SECURITY_STRATEGY=Enforce")
-                && e.contains("/ks")
-                && e.contains("unset ROS_SECURITY_ENABLE")
-                && e.contains("Permissive"),
+            e.contains("ROS_SECURITY_KEYSTORE is not set") && e.contains("create_enclave"),
             "{e}"
         );
-        // Permissive (or anything but Enforce): a warning.
-        for strategy in ["Permissive", "enforce", ""] {
-            let w = security(env(match strategy {
-                "Permissive" => &[
-                    ("ROS_SECURITY_ENABLE", "true"),
-                    ("ROS_SECURITY_STRATEGY", "Permissive"),
-                ],
-                "enforce" => &[
-                    ("ROS_SECURITY_ENABLE", "true"),
-                    ("ROS_SECURITY_STRATEGY", "enforce"),
-                ],
-                _ => &[("ROS_SECURITY_ENABLE", "true")],
-            }))
-            .unwrap()
-            .unwrap();
-            assert!(w.contains("unauthenticated and unencrypted"), "{w}");
+        let keystore = std::env::temp_dir().join(format!("slosh-keystore-{}", std::process::id()));
+        let dir = keystore.join("enclaves/ship/tank");
+        std::fs::create_dir_all(&dir).unwrap();
+        for f in &ENCLAVE_FILES[..5] {
+            std::fs::write(dir.join(f), "x").unwrap();
         }
+        let vars = |strategy: &str| {
+            on(vec![
+                ("ROS_SECURITY_STRATEGY", strategy.to_string()),
+                ("ROS_SECURITY_KEYSTORE", keystore.display().to_string()),
+                ("ROS_SECURITY_ENCLAVE_OVERRIDE", "/ship/tank".into()),
+            ])
+        };
+        let e = security(env(vars("Enforce"))).unwrap_err().to_string();
+        assert!(
+            e.contains("permissions.p7s is missing") && e.contains("/ship/tank"),
+            "{e}"
+        );
+        // Permissive (anything but Enforce): unsecured, with the warning.
+        for strategy in ["Permissive", "enforce"] {
+            match security(env(vars(strategy))).unwrap() {
+                Security::Unsecured(w) => assert!(w.contains("joining unsecured"), "{w}"),
+                other => panic!("{other:?}"),
+            }
+        }
+        // Every file there: the enclave's folder.
+        std::fs::write(dir.join(ENCLAVE_FILES[5]), "x").unwrap();
+        assert_eq!(
+            security(env(vars("Enforce"))).unwrap(),
+            Security::Enclave(dir)
+        );
+        let _ = std::fs::remove_dir_all(&keystore);
     }
 }
