@@ -62,8 +62,21 @@ const GOVERNANCE: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 </dds>
 "#;
 
-/// The permissions of enclave `name` (certificate subject CN=`name`): every topic on the test's domain.
+/// The permissions of enclave `name` (certificate subject CN=`name`): every topic on the test's domain, or
+/// for `limited` only ROS 2's own (discovery, rosout, parameter events) and `rt/elsewhere`.
 fn permissions(name: &str) -> String {
+    let topics = if name == "limited" {
+        [
+            "ros_discovery_info",
+            "rt/rosout",
+            "rt/parameter_events",
+            "rt/elsewhere",
+        ]
+        .map(|t| format!("<topic>{t}</topic>"))
+        .concat()
+    } else {
+        "<topic>*</topic>".to_string()
+    };
     format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170901/omg_shared_ca_permissions.xsd">
@@ -73,8 +86,8 @@ fn permissions(name: &str) -> String {
       <validity><not_before>2020-01-01T00:00:00</not_before><not_after>2100-01-01T00:00:00</not_after></validity>
       <allow_rule>
         <domains><id>{DOMAIN}</id></domains>
-        <publish><topics><topic>*</topic></topics></publish>
-        <subscribe><topics><topic>*</topic></topics></subscribe>
+        <publish><topics>{topics}</topics></publish>
+        <subscribe><topics>{topics}</topics></subscribe>
       </allow_rule>
       <default>DENY</default>
     </grant>
@@ -242,7 +255,7 @@ fn a_secured_node_talks_to_secured_peers_only() {
     }
     let dir = common::tmp("sros2");
     let ks = dir.join("keystore");
-    keystore(&ks, &["node", "driver"]);
+    keystore(&ks, &["node", "driver", "limited"]);
     let case = dir.join("case.yaml");
     std::fs::write(&case, common::small_case_at(0.04, "")).unwrap();
     let mut proc = slosh()
@@ -264,6 +277,38 @@ fn a_secured_node_talks_to_secured_peers_only() {
     let driver_dir = ks.join("enclaves/driver");
     let (_sctx, mut secured) = participant(Some(&driver_dir), "driver");
     let (_uctx, mut open) = participant(None, "intruder");
+    // Authenticated, but its permissions grant only ROS 2's own topics and rt/elsewhere: DDS-Security
+    // refuses it the node's topics (at their creation: it can neither feed the node nor read it).
+    let limited_dir = ks.join("enclaves/limited");
+    let (_lctx, limited) = participant(Some(&limited_dir), "limited");
+    for (ns, name, type_name) in [
+        (
+            "/sec/motion",
+            "odom",
+            MessageTypeName::new("nav_msgs", "Odometry"),
+        ),
+        (
+            "/sec",
+            "wrench",
+            MessageTypeName::new("geometry_msgs", "WrenchStamped"),
+        ),
+    ] {
+        let refused = limited
+            .create_topic(&Name::new(ns, name).unwrap(), type_name, &qos)
+            .map(|_| ())
+            .unwrap_err();
+        assert!(
+            format!("{refused:?}").contains("not allowed by security"),
+            "{name}: {refused:?}"
+        );
+    }
+    limited
+        .create_topic(
+            &Name::new("/", "elsewhere").unwrap(),
+            MessageTypeName::new("nav_msgs", "Odometry"),
+            &qos,
+        )
+        .expect("the topic its permissions grant");
     let motion_topic = topic::<Odometry>(&mut secured, "/sec/motion/odom", &qos);
     let motion = secured
         .create_publisher::<Odometry>(&motion_topic, Some(qos.clone()))
@@ -324,5 +369,39 @@ fn a_secured_node_talks_to_secured_peers_only() {
         .find(|l| l.contains("stopping at t ="))
         .unwrap_or_else(|| panic!("{log}"));
     assert!(stop.contains(" 0 rejected"), "{stop}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A keystore whose files are there but do not make a participant (the certificate is not one): both commands
+/// stop at start-up with the enclave's folder.
+#[test]
+fn a_broken_keystore_stops_the_node_at_start_up() {
+    if !common::in_private_netns("a_broken_keystore_stops_the_node_at_start_up") {
+        return;
+    }
+    let dir = common::tmp("sros2-broken");
+    let ks = dir.join("keystore");
+    keystore(&ks, &["node"]);
+    std::fs::write(ks.join("enclaves/node/cert.pem"), "not a certificate\n").unwrap();
+    for args in [
+        vec!["node", "--duration", "1", "seed_tank_039"],
+        vec!["motion", "seed_tank_039", "--duration", "1"],
+    ] {
+        let o = slosh()
+            .args(&args)
+            .env("ROS_DOMAIN_ID", DOMAIN.to_string())
+            .env("ROS_SECURITY_ENABLE", "true")
+            .env("ROS_SECURITY_STRATEGY", "Enforce")
+            .env("ROS_SECURITY_KEYSTORE", &ks)
+            .env("ROS_SECURITY_ENCLAVE_OVERRIDE", "/node")
+            .output()
+            .unwrap();
+        assert!(!o.status.success(), "{args:?} started");
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            e.contains("cannot start secured DDS") && e.contains("enclaves/node"),
+            "{args:?}: {e}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
