@@ -5,7 +5,8 @@
 //! restarted (a new DDS writer) — beside a reliable subscriber of the outputs that never reads, and ended
 //! by SIGINT while the node works. Passes when the node exits cleanly; every motion sample it took (accepted
 //! or refused) is in the bag, and every output it published; the bag reads with rosbags and mcap; its
-//! resident memory is flat after the first fifth of the run. The figures go to stdout. The hour:
+//! resident memory is flat after the first fifth of the run. The figures go to stdout. The faults that need
+//! the wall clock (input gaps past the timeout, a looped bag's clock) are the second test. The hour:
 //!
 //!     SLOSH_SOAK_SECONDS=3600 cargo test --release -p slosh-node --test soak -- --nocapture
 
@@ -328,4 +329,164 @@ fn an_hour_of_faulty_motion_loses_nothing() {
         "resident memory grew from {settled} kB to {peak} kB: {rss:?}"
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The faults that need the wall clock, `SLOSH_SOAK_WALL_SECONDS` (20 in the test command) each: a `realtime`
+/// node whose input stops every 5 s for longer than `motion_timeout_s` (it holds the last pose and takes the
+/// input back), and a `follow_clock` node fed as by a looped bag (every 8 s `/clock` and the stamps jump
+/// back to the start). Passes when the node exits cleanly after SIGINT, every motion sample it took is in
+/// the bag (read by rosbags and mcap), every output it published too, and outputs go on after each fault.
+#[test]
+fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
+    if !common::in_private_netns("input_gaps_and_a_clock_that_jumps_back_lose_nothing") {
+        return;
+    }
+    let seconds: f64 = std::env::var("SLOSH_SOAK_WALL_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20.0);
+    for (mode, domain) in [("realtime", 63u16), ("follow_clock", 64)] {
+        let dir = common::tmp(&format!("soak-{mode}"));
+        let case = dir.join("case.yaml");
+        std::fs::write(&case, common::small_case_at(0.04, "")).unwrap();
+        let bag = dir.join("bag");
+        let mut proc = Kill(
+            slosh()
+                .args(["node", "--ros-args", "--params-file"])
+                .arg(&case)
+                .args(["-r", &format!("__ns:={NS}"), "-p"])
+                .arg(format!("realtime.mode:={mode}"))
+                .args([
+                    "-p",
+                    "output_rate_hz:=20.0",
+                    "-p",
+                    "motion_timeout_s:=0.5",
+                    "-p",
+                ])
+                .arg(format!("record.path:={}", bag.display()))
+                .env("ROS_DOMAIN_ID", domain.to_string())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap(),
+        );
+        let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
+        let mut node = ctx
+            .new_node(
+                NodeName::new("/", "soak_driver").unwrap(),
+                NodeOptions::new().enable_rosout(false),
+            )
+            .unwrap();
+        let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 50 });
+        let odom_topic = topic::<Odometry>(&mut node, &format!("{NS}/motion/odom"), &qos);
+        let publisher = node
+            .create_publisher::<Odometry>(&odom_topic, Some(qos.clone()))
+            .unwrap();
+        let clock_topic = topic::<Clock>(&mut node, "/clock", &qos);
+        let clock = node
+            .create_publisher::<Clock>(&clock_topic, Some(qos.clone()))
+            .unwrap();
+        let seen = Instant::now();
+        while node.subscription_count(&format!("{NS}/motion/odom")) == 0 {
+            assert!(
+                seen.elapsed() < Duration::from_secs(30),
+                "the node never subscribed"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        std::thread::sleep(Duration::from_millis(300));
+        let start = Instant::now();
+        let (mut sent, mut faults) = (0u64, 0u32);
+        let mut k = 0u64;
+        let mut in_gap = false;
+        while start.elapsed().as_secs_f64() < seconds {
+            let t = k as f64 / RATE;
+            k += 1;
+            // Paced by the wall clock.
+            let due = Duration::from_secs_f64(t);
+            if let Some(wait) = due.checked_sub(start.elapsed()) {
+                std::thread::sleep(wait);
+            }
+            let stamp = match mode {
+                // Every 5 s the input stops for 1 s (motion_timeout_s is 0.5 s); its stamps go on.
+                "realtime" => {
+                    let gap = t % 5.0 >= 4.0;
+                    if gap && !in_gap {
+                        faults += 1;
+                    }
+                    in_gap = gap;
+                    if gap {
+                        continue;
+                    }
+                    T0 + t
+                }
+                // A looped 8 s bag: /clock and the stamps start again every 8 s.
+                _ => {
+                    if k > 1 && (k - 1) % (8 * RATE as u64) == 0 {
+                        faults += 1;
+                    }
+                    let stamp = T0 + t % 8.0;
+                    clock
+                        .publish(Clock {
+                            clock: Time::from_secs_f64(stamp),
+                        })
+                        .unwrap();
+                    stamp
+                }
+            };
+            publisher.publish(odometry(t, stamp)).unwrap();
+            sent += 1;
+        }
+        std::thread::sleep(Duration::from_millis(300));
+        assert!(Command::new("kill")
+            .args(["-INT", &proc.0.id().to_string()])
+            .status()
+            .unwrap()
+            .success());
+        let mut log = String::new();
+        if let Some(mut e) = proc.0.stderr.take() {
+            std::io::Read::read_to_string(&mut e, &mut log).unwrap();
+        }
+        let status = proc.0.wait().unwrap();
+        assert!(status.success(), "{mode}: {status}: {log}");
+        let (accepted, rejected, published) = (
+            count(&log, "samples accepted"),
+            count(&log, "rejected"),
+            count(&log, "outputs published"),
+        );
+        let read = common::read_bag(&bag);
+        let in_bag = |reader: &str, name: &str| {
+            read[reader][name]["items"]
+                .as_array()
+                .map_or(0, |v| v.len() as u64)
+        };
+        let (odom, wrench) = (format!("{NS}/motion/odom"), format!("{NS}/wrench"));
+        println!(
+            "soak ({mode}): {seconds} s, {sent} samples sent, {faults} faults; the node took {accepted} and refused {rejected}, published {published} outputs; the bag holds {} motion samples and {} wrenches",
+            in_bag("rosbags", &odom),
+            in_bag("rosbags", &wrench)
+        );
+        for reader in ["rosbags", "mcap"] {
+            assert_eq!(
+                in_bag(reader, &odom),
+                accepted + rejected,
+                "{mode}, {reader}: motion samples"
+            );
+            assert_eq!(
+                in_bag(reader, &wrench),
+                published,
+                "{mode}, {reader}: wrenches"
+            );
+        }
+        assert!(faults >= 2, "{mode}: {faults} faults");
+        assert!(
+            accepted + rejected <= sent && accepted > sent / 2,
+            "{mode}: {accepted} of {sent}"
+        );
+        // Outputs go on through the faults: at least half the wall time's worth at 20 Hz.
+        assert!(
+            published as f64 > 0.5 * 20.0 * seconds,
+            "{mode}: {published} outputs\n{log}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }
