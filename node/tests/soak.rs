@@ -432,7 +432,7 @@ fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
                 }
                 // A looped 8 s bag: /clock and the stamps start again every 8 s.
                 _ => {
-                    if k > 1 && (k - 1) % (8 * RATE as u64) == 0 {
+                    if k > 1 && (k - 1).is_multiple_of(8 * RATE as u64) {
                         faults += 1;
                     }
                     let stamp = T0 + t % 8.0;
