@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::slosh;
+use common::{rest_odometry, slosh, Kill};
 
 use ros2_client::qos::{History, WhenFull};
 use ros2_client::{
@@ -12,7 +12,6 @@ use ros2_client::{
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus};
 use slosh_msgs::geometry_msgs::{Accel, AccelStamped, PoseStamped, Vector3, WrenchStamped};
-use slosh_msgs::geometry_msgs::{Pose, PoseWithCovariance, Quaternion, TwistWithCovariance};
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
 use slosh_msgs::slosh_msgs::ProbeArray;
@@ -31,14 +30,6 @@ const EXTRA: &str = "    pressure_sensors: {names: [wall], x: [-0.4], y: [0.0], 
 /// Start of the motion's stamps (s since the epoch) so that output stamps map back to simulation time.
 const T0: f64 = 1000.0;
 const DURATION: f64 = 3.0;
-
-struct Kill(Child);
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// A DDS context on `domain` and a node of this test in it (keep the context alive with the node).
 fn test_node(domain: u16, name: &str) -> (Context, ros2_client::Node) {
@@ -416,25 +407,6 @@ fn publisher<M: RosMessage>(
         .unwrap();
     node.create_publisher::<M>(&topic, Some(qos.clone()))
         .unwrap()
-}
-
-/// Odometry of a vessel at rest at the origin, stamped `t` s.
-fn rest_odometry(t: f64) -> Odometry {
-    Odometry {
-        header: Header {
-            stamp: Time::from_secs_f64(t),
-            frame_id: "odom".into(),
-        },
-        child_frame_id: "base_link".into(),
-        pose: PoseWithCovariance {
-            pose: Pose {
-                orientation: Quaternion::identity(),
-                ..Default::default()
-            },
-            covariance: [0.0; 36],
-        },
-        twist: TwistWithCovariance::default(),
-    }
 }
 
 /// `slosh node` on `case` (with `extra` ROS arguments) in DDS domain `domain`, its log captured, once `node`

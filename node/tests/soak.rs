@@ -12,20 +12,14 @@
 
 mod common;
 
-use common::slosh;
+use common::{rest_odometry, ros_topic, slosh, stop_count, Kill};
 use ros2_client::qos::{History, WhenFull};
-use ros2_client::{
-    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
-};
+use ros2_client::{Context, ContextOptions, NodeName, NodeOptions, QosProfile};
 use slosh_msgs::builtin_interfaces::Time;
-use slosh_msgs::geometry_msgs::{
-    Pose, PoseWithCovariance, Quaternion, TwistWithCovariance, WrenchStamped,
-};
+use slosh_msgs::geometry_msgs::WrenchStamped;
 use slosh_msgs::nav_msgs::Odometry;
 use slosh_msgs::rosgraph_msgs::Clock;
-use slosh_msgs::std_msgs::Header;
-use slosh_msgs::RosMessage;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const RATE: f64 = 50.0;
@@ -35,39 +29,11 @@ const T0: f64 = 5000.0;
 /// input delay and up to an output period).
 const LEAD: f64 = 12.0;
 
-fn topic<M: RosMessage>(
-    node: &mut ros2_client::Node,
-    name: &str,
-    qos: &QosProfile,
-) -> ros2_client::dds::rustdds::Topic {
-    let (ns, base) = name.rsplit_once('/').unwrap();
-    node.create_topic(
-        &Name::new(if ns.is_empty() { "/" } else { ns }, base).unwrap(),
-        MessageTypeName::new(M::PACKAGE, M::NAME),
-        qos,
-    )
-    .unwrap()
-}
-
 /// A swaying vessel at time `t` (s of motion), stamped `stamp`.
 fn odometry(t: f64, stamp: f64) -> Odometry {
-    let mut pose = Pose {
-        orientation: Quaternion::identity(),
-        ..Default::default()
-    };
-    pose.position.x = 0.02 * (2.0 * std::f64::consts::PI * t / 1.3).sin();
-    Odometry {
-        header: Header {
-            stamp: Time::from_secs_f64(stamp),
-            frame_id: "odom".into(),
-        },
-        child_frame_id: "base_link".into(),
-        pose: PoseWithCovariance {
-            pose,
-            covariance: [0.0; 36],
-        },
-        twist: TwistWithCovariance::default(),
-    }
+    let mut m = rest_odometry(stamp);
+    m.pose.pose.position.x = 0.02 * (2.0 * std::f64::consts::PI * t / 1.3).sin();
+    m
 }
 
 /// Resident memory of process `pid`, kB.
@@ -79,32 +45,6 @@ fn rss_kb(pid: u32) -> Option<u64> {
         .nth(1)?
         .parse()
         .ok()
-}
-
-/// `what: N` counted in the node's stop line.
-fn count(log: &str, what: &str) -> u64 {
-    let line = log
-        .lines()
-        .find(|l| l.contains("stopping at t ="))
-        .unwrap_or_else(|| panic!("no stop line in the log:\n{log}"));
-    let at = line
-        .find(what)
-        .unwrap_or_else(|| panic!("{what} in {line}"));
-    line[..at]
-        .split_whitespace()
-        .last()
-        .unwrap()
-        .trim_start_matches([',', ':'])
-        .parse()
-        .unwrap_or_else(|e| panic!("{e}: {line}"))
-}
-
-struct Kill(Child);
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
 }
 
 #[test]
@@ -148,12 +88,12 @@ fn an_hour_of_faulty_motion_loses_nothing() {
         )
         .unwrap();
     let odom_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 50 });
-    let odom_topic = topic::<Odometry>(&mut node, &format!("{NS}/motion/odom"), &odom_qos);
+    let odom_topic = ros_topic::<Odometry>(&mut node, &format!("{NS}/motion/odom"), &odom_qos);
     let mut publisher = node
         .create_publisher::<Odometry>(&odom_topic, Some(odom_qos.clone()))
         .unwrap();
     let clock_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 1 });
-    let clock_topic = topic::<Clock>(&mut node, "/clock", &clock_qos);
+    let clock_topic = ros_topic::<Clock>(&mut node, "/clock", &clock_qos);
     let clock = node
         .create_subscription::<Clock>(&clock_topic, Some(clock_qos))
         .unwrap();
@@ -161,7 +101,7 @@ fn an_hour_of_faulty_motion_loses_nothing() {
     let stall_qos = QosProfile::publisher_default()
         .reliability_reliable(WhenFull::Wait(Duration::from_millis(100)))
         .history(History::KeepLast { depth: 1 });
-    let stall_topic = topic::<WrenchStamped>(&mut node, &format!("{NS}/wrench"), &stall_qos);
+    let stall_topic = ros_topic::<WrenchStamped>(&mut node, &format!("{NS}/wrench"), &stall_qos);
     let _stalled = node
         .create_subscription::<WrenchStamped>(&stall_topic, Some(stall_qos))
         .unwrap();
@@ -284,9 +224,9 @@ fn an_hour_of_faulty_motion_loses_nothing() {
     assert!(status.success(), "{status}: {log}");
     let wall = start.elapsed().as_secs_f64();
     let (accepted, rejected, published) = (
-        count(&log, "samples accepted"),
-        count(&log, "rejected"),
-        count(&log, "outputs published"),
+        stop_count(&log, "samples accepted"),
+        stop_count(&log, "rejected"),
+        stop_count(&log, "outputs published"),
     );
 
     let read = common::read_bag(&bag);
@@ -388,11 +328,11 @@ fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
             )
             .unwrap();
         let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 50 });
-        let odom_topic = topic::<Odometry>(&mut node, &format!("{NS}/motion/odom"), &qos);
+        let odom_topic = ros_topic::<Odometry>(&mut node, &format!("{NS}/motion/odom"), &qos);
         let publisher = node
             .create_publisher::<Odometry>(&odom_topic, Some(qos.clone()))
             .unwrap();
-        let clock_topic = topic::<Clock>(&mut node, "/clock", &qos);
+        let clock_topic = ros_topic::<Clock>(&mut node, "/clock", &qos);
         let clock = node
             .create_publisher::<Clock>(&clock_topic, Some(qos.clone()))
             .unwrap();
@@ -460,9 +400,9 @@ fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
         let status = proc.0.wait().unwrap();
         assert!(status.success(), "{mode}: {status}: {log}");
         let (accepted, rejected, published) = (
-            count(&log, "samples accepted"),
-            count(&log, "rejected"),
-            count(&log, "outputs published"),
+            stop_count(&log, "samples accepted"),
+            stop_count(&log, "rejected"),
+            stop_count(&log, "outputs published"),
         );
         let read = common::read_bag(&bag);
         let in_bag = |reader: &str, name: &str| {

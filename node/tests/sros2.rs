@@ -5,18 +5,13 @@
 
 mod common;
 
-use common::slosh;
+use common::{rest_odometry, ros_topic, slosh};
 use ros2_client::qos::{History, WhenFull};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
 };
-use slosh_msgs::builtin_interfaces::Time;
-use slosh_msgs::geometry_msgs::{
-    Pose, PoseWithCovariance, Quaternion, TwistWithCovariance, WrenchStamped,
-};
+use slosh_msgs::geometry_msgs::WrenchStamped;
 use slosh_msgs::nav_msgs::Odometry;
-use slosh_msgs::std_msgs::Header;
-use slosh_msgs::RosMessage;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -200,20 +195,6 @@ fn keystore(root: &Path, names: &[&str]) {
     }
 }
 
-fn topic<M: RosMessage>(
-    node: &mut ros2_client::Node,
-    name: &str,
-    qos: &QosProfile,
-) -> ros2_client::dds::rustdds::Topic {
-    let (ns, base) = name.rsplit_once('/').unwrap();
-    node.create_topic(
-        &Name::new(if ns.is_empty() { "/" } else { ns }, base).unwrap(),
-        MessageTypeName::new(M::PACKAGE, M::NAME),
-        qos,
-    )
-    .unwrap()
-}
-
 /// A ROS 2 node of the test on the test's domain, secured with the enclave in `dir` (None: unsecured).
 fn participant(dir: Option<&PathBuf>, name: &str) -> (Context, ros2_client::Node) {
     let mut options = ContextOptions::new().domain_id(DOMAIN);
@@ -228,24 +209,6 @@ fn participant(dir: Option<&PathBuf>, name: &str) -> (Context, ros2_client::Node
         )
         .unwrap();
     (ctx, node)
-}
-
-fn odometry(stamp: f64) -> Odometry {
-    Odometry {
-        header: Header {
-            stamp: Time::from_secs_f64(stamp),
-            frame_id: "odom".into(),
-        },
-        child_frame_id: "base_link".into(),
-        pose: PoseWithCovariance {
-            pose: Pose {
-                orientation: Quaternion::identity(),
-                ..Default::default()
-            },
-            covariance: [0.0; 36],
-        },
-        twist: TwistWithCovariance::default(),
-    }
 }
 
 #[test]
@@ -309,19 +272,19 @@ fn a_secured_node_talks_to_secured_peers_only() {
             &qos,
         )
         .expect("the topic its permissions grant");
-    let motion_topic = topic::<Odometry>(&mut secured, "/sec/motion/odom", &qos);
+    let motion_topic = ros_topic::<Odometry>(&mut secured, "/sec/motion/odom", &qos);
     let motion = secured
         .create_publisher::<Odometry>(&motion_topic, Some(qos.clone()))
         .unwrap();
-    let wrench_topic = topic::<WrenchStamped>(&mut secured, "/sec/wrench", &qos);
+    let wrench_topic = ros_topic::<WrenchStamped>(&mut secured, "/sec/wrench", &qos);
     let wrench = secured
         .create_subscription::<WrenchStamped>(&wrench_topic, Some(qos.clone()))
         .unwrap();
-    let forged_topic = topic::<Odometry>(&mut open, "/sec/motion/odom", &qos);
+    let forged_topic = ros_topic::<Odometry>(&mut open, "/sec/motion/odom", &qos);
     let forged = open
         .create_publisher::<Odometry>(&forged_topic, Some(qos.clone()))
         .unwrap();
-    let eavesdrop_topic = topic::<WrenchStamped>(&mut open, "/sec/wrench", &qos);
+    let eavesdrop_topic = ros_topic::<WrenchStamped>(&mut open, "/sec/wrench", &qos);
     let eavesdrop = open
         .create_subscription::<WrenchStamped>(&eavesdrop_topic, Some(qos.clone()))
         .unwrap();
@@ -333,8 +296,8 @@ fn a_secured_node_talks_to_secured_peers_only() {
     let mut k = 0u64;
     while start.elapsed() < Duration::from_secs(40) && got < 40 {
         let t = k as f64 / 50.0;
-        motion.publish(odometry(1000.0 + t)).unwrap();
-        let _ = forged.publish(odometry(5000.0 + t));
+        motion.publish(rest_odometry(1000.0 + t)).unwrap();
+        let _ = forged.publish(rest_odometry(5000.0 + t));
         k += 1;
         std::thread::sleep(Duration::from_millis(20));
         while let Ok(Some(_)) = wrench.take() {

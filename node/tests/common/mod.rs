@@ -192,3 +192,67 @@ pub fn mpirun(ranks: usize) -> Command {
         .arg(env!("CARGO_BIN_EXE_slosh"));
     c
 }
+
+/// A child process killed and reaped when dropped: a test that fails leaves no node running.
+pub struct Kill(pub std::process::Child);
+
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// The DDS topic of `M` on the absolute ROS name `name` (e.g. `/ns/motion/odom`) for a test's participant.
+pub fn ros_topic<M: slosh_msgs::RosMessage>(
+    node: &mut ros2_client::Node,
+    name: &str,
+    qos: &ros2_client::QosProfile,
+) -> ros2_client::dds::rustdds::Topic {
+    let (ns, base) = name.rsplit_once('/').expect("an absolute name");
+    node.create_topic(
+        &ros2_client::Name::new(if ns.is_empty() { "/" } else { ns }, base).unwrap(),
+        ros2_client::MessageTypeName::new(M::PACKAGE, M::NAME),
+        qos,
+    )
+    .unwrap()
+}
+
+/// Odometry of a vessel at rest at the origin, stamped `t` s.
+pub fn rest_odometry(t: f64) -> slosh_msgs::nav_msgs::Odometry {
+    use slosh_msgs::geometry_msgs::{Pose, PoseWithCovariance, Quaternion, TwistWithCovariance};
+    slosh_msgs::nav_msgs::Odometry {
+        header: slosh_msgs::std_msgs::Header {
+            stamp: slosh_msgs::builtin_interfaces::Time::from_secs_f64(t),
+            frame_id: "odom".into(),
+        },
+        child_frame_id: "base_link".into(),
+        pose: PoseWithCovariance {
+            pose: Pose {
+                orientation: Quaternion::identity(),
+                ..Default::default()
+            },
+            covariance: [0.0; 36],
+        },
+        twist: TwistWithCovariance::default(),
+    }
+}
+
+/// The number before `what` in `slosh node`'s stop line (`stopping at t = ... s: N samples accepted, M
+/// rejected, K outputs published`) in its log.
+pub fn stop_count(log: &str, what: &str) -> u64 {
+    let line = log
+        .lines()
+        .find(|l| l.contains("stopping at t ="))
+        .unwrap_or_else(|| panic!("no stop line in the log:\n{log}"));
+    let at = line
+        .find(what)
+        .unwrap_or_else(|| panic!("{what} in {line}"));
+    line[..at]
+        .split_whitespace()
+        .last()
+        .unwrap()
+        .trim_start_matches([',', ':'])
+        .parse()
+        .unwrap_or_else(|e| panic!("{e}: {line}"))
+}
