@@ -79,6 +79,8 @@ fn an_hour_of_faulty_motion_loses_nothing() {
             .unwrap(),
     );
     let pid = proc.0.id();
+    // (Read as it comes: over an hour the node's log outgrows a pipe's buffer.)
+    let stderr = common::drain_stderr(&mut proc.0);
 
     let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
     let mut node = ctx
@@ -216,10 +218,7 @@ fn an_hour_of_faulty_motion_loses_nothing() {
         .status()
         .unwrap()
         .success());
-    let mut log = String::new();
-    if let Some(mut e) = proc.0.stderr.take() {
-        std::io::Read::read_to_string(&mut e, &mut log).unwrap();
-    }
+    let log = stderr.join().unwrap();
     let status = proc.0.wait().unwrap();
     assert!(status.success(), "{status}: {log}");
     let wall = start.elapsed().as_secs_f64();
@@ -302,6 +301,7 @@ fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
                 .spawn()
                 .unwrap(),
         );
+        let stderr = common::drain_stderr(&mut proc.0);
         let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
         let mut node = ctx
             .new_node(
@@ -375,10 +375,7 @@ fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
             .status()
             .unwrap()
             .success());
-        let mut log = String::new();
-        if let Some(mut e) = proc.0.stderr.take() {
-            std::io::Read::read_to_string(&mut e, &mut log).unwrap();
-        }
+        let log = stderr.join().unwrap();
         let status = proc.0.wait().unwrap();
         assert!(status.success(), "{mode}: {status}: {log}");
         let Accounts {

@@ -256,3 +256,14 @@ pub fn stop_count(log: &str, what: &str) -> u64 {
         .parse()
         .unwrap_or_else(|e| panic!("{e}: {line}"))
 }
+
+/// Reads `child`'s piped stderr as it comes (a child whose stderr pipe fills up blocks on its next log line),
+/// and gives it whole once the child has closed it.
+pub fn drain_stderr(child: &mut std::process::Child) -> std::thread::JoinHandle<String> {
+    let mut err = child.stderr.take().expect("stderr piped");
+    std::thread::spawn(move || {
+        let mut log = String::new();
+        let _ = std::io::Read::read_to_string(&mut err, &mut log);
+        log
+    })
+}
