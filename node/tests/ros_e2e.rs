@@ -31,18 +31,6 @@ const EXTRA: &str = "    pressure_sensors: {names: [wall], x: [-0.4], y: [0.0], 
 const T0: f64 = 1000.0;
 const DURATION: f64 = 3.0;
 
-/// A DDS context on `domain` and a node of this test in it (keep the context alive with the node).
-fn test_node(domain: u16, name: &str) -> (Context, ros2_client::Node) {
-    let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
-    let node = ctx
-        .new_node(
-            NodeName::new("/", name).unwrap(),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .unwrap();
-    (ctx, node)
-}
-
 fn sub<M: RosMessage + 'static>(
     node: &mut ros2_client::Node,
     ns: &str,
@@ -112,7 +100,7 @@ fn compare_with_run_on(kind: &str, domain_id: u16, ranks: usize) {
     let domain = domain.as_str();
 
     // The subscriber first, so it sees every output.
-    let (_ctx, mut node) = test_node(domain_id, "e2e_listener");
+    let (_ctx, mut node) = common::participant(domain_id, "e2e_listener");
     let wrench = sub::<WrenchStamped>(&mut node, "/ship1", "wrench");
     let probes = sub::<ProbeArray>(&mut node, "/ship1", "probes");
     let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
@@ -487,7 +475,7 @@ fn pause_and_reset_services() {
         return;
     }
     let (dir, case) = common::case_dir("ros-services", "");
-    let (_ctx, mut node) = test_node(31, "e2e_services");
+    let (_ctx, mut node) = common::participant(31, "e2e_services");
     let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
@@ -594,7 +582,7 @@ fn follow_clock_never_runs_ahead_of_ros_time() {
         return;
     }
     let (dir, case) = common::case_dir("ros-clock", "");
-    let (_ctx, mut node) = test_node(37, "e2e_clock");
+    let (_ctx, mut node) = common::participant(37, "e2e_clock");
     let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
@@ -757,7 +745,7 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
         ),
     )
     .unwrap();
-    let (_ctx, mut node) = test_node(43, "e2e_timeout");
+    let (_ctx, mut node) = common::participant(43, "e2e_timeout");
     let wrench = sub::<WrenchStamped>(&mut node, "/", "wrench");
     let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
@@ -898,7 +886,7 @@ fn receive_stamps_are_the_arrival_times_even_while_the_node_is_stepping() {
     let text = common::small_case("    input: {stamp: receive}\n")
         .replace("particle_spacing: 0.02", "particle_spacing: 0.005");
     std::fs::write(&case, text).unwrap();
-    let (_ctx, mut node) = test_node(45, "e2e_receive");
+    let (_ctx, mut node) = common::participant(45, "e2e_receive");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
     let proc = logged_node(&node, &case, &[], 45, &["/motion/odom"]);
@@ -958,7 +946,7 @@ fn accelerations_on_another_clock_than_the_motion_are_rejected_and_said() {
     let dir = common::tmp("ros-accel-clock");
     let case = dir.join("case.yaml");
     std::fs::write(&case, common::small_case("    input: {accel: true}\n")).unwrap();
-    let (_ctx, mut node) = test_node(48, "e2e_accel_clock");
+    let (_ctx, mut node) = common::participant(48, "e2e_accel_clock");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
     let accel = publisher::<AccelStamped>(&mut node, "/motion", "accel", &qos);
@@ -1054,7 +1042,7 @@ fn a_publisher_of_another_type_on_the_motion_topic_is_named() {
     let dir = common::tmp("ros-wrong-type");
     let case = dir.join("case.yaml");
     std::fs::write(&case, common::small_case("")).unwrap();
-    let (_ctx, mut node) = test_node(52, "e2e_wrong_type");
+    let (_ctx, mut node) = common::participant(52, "e2e_wrong_type");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     // PoseStamped on the topic where the node takes Odometry (input.type odom). DDS delivers it (it matches
     // by topic name): the node refuses what it cannot decode, goes on, and names the publisher's type.
@@ -1088,7 +1076,7 @@ fn poses_read_in_the_wrong_frame_convention_are_said() {
     let dir = common::tmp("ros-frame-check");
     let case = dir.join("case.yaml");
     std::fs::write(&case, common::small_case("")).unwrap();
-    let (_ctx, mut node) = test_node(50, "e2e_frame_check");
+    let (_ctx, mut node) = common::participant(50, "e2e_frame_check");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
     let diag = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
@@ -1141,7 +1129,7 @@ fn a_clock_on_another_time_base_than_the_motion_is_said() {
     let dir = common::tmp("ros-clock-base");
     let case = dir.join("case.yaml");
     std::fs::write(&case, common::small_case("    use_sim_time: true\n")).unwrap();
-    let (_ctx, mut node) = test_node(49, "e2e_clock_base");
+    let (_ctx, mut node) = common::participant(49, "e2e_clock_base");
     let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
     let odom = publisher::<Odometry>(&mut node, "/motion", "odom", &qos);
     let clock = publisher::<Clock>(&mut node, "/", "clock", &qos);
@@ -1261,7 +1249,7 @@ fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
         .replace("particle_spacing: 0.02", "particle_spacing: 0.01"),
     )
     .unwrap();
-    let (_ctx, mut node) = test_node(47, "e2e_autores");
+    let (_ctx, mut node) = common::participant(47, "e2e_autores");
     let diags = sub::<DiagnosticArray>(&mut node, "/", "diagnostics");
     let bag = dir.join("bag");
     let mut proc = Kill(

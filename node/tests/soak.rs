@@ -14,7 +14,7 @@ mod common;
 
 use common::{rest_odometry, ros_topic, slosh, stop_count, Kill};
 use ros2_client::qos::{History, WhenFull};
-use ros2_client::{Context, ContextOptions, NodeName, NodeOptions, QosProfile};
+use ros2_client::QosProfile;
 use slosh_msgs::builtin_interfaces::Time;
 use slosh_msgs::geometry_msgs::WrenchStamped;
 use slosh_msgs::nav_msgs::Odometry;
@@ -82,13 +82,7 @@ fn an_hour_of_faulty_motion_loses_nothing() {
     // (Read as it comes: over an hour the node's log outgrows a pipe's buffer.)
     let stderr = common::drain_stderr(&mut proc.0);
 
-    let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
-    let mut node = ctx
-        .new_node(
-            NodeName::new("/", "soak_driver").unwrap(),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .unwrap();
+    let (_ctx, mut node) = common::participant(domain, "soak_driver");
     let odom_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 50 });
     let odom_topic = ros_topic::<Odometry>(&mut node, &format!("{NS}/motion/odom"), &odom_qos);
     let mut publisher = node
@@ -302,13 +296,7 @@ fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
                 .unwrap(),
         );
         let stderr = common::drain_stderr(&mut proc.0);
-        let ctx = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
-        let mut node = ctx
-            .new_node(
-                NodeName::new("/", "soak_driver").unwrap(),
-                NodeOptions::new().enable_rosout(false),
-            )
-            .unwrap();
+        let (_ctx, mut node) = common::participant(domain, "soak_driver");
         let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 50 });
         let odom_topic = ros_topic::<Odometry>(&mut node, &format!("{NS}/motion/odom"), &qos);
         let publisher = node

@@ -267,3 +267,17 @@ pub fn drain_stderr(child: &mut std::process::Child) -> std::thread::JoinHandle<
         log
     })
 }
+
+/// A DDS context on `domain` and a node of the test in it named `name` (keep the context alive with the node).
+pub fn participant(domain: u16, name: &str) -> (ros2_client::Context, ros2_client::Node) {
+    let ctx =
+        ros2_client::Context::with_options(ros2_client::ContextOptions::new().domain_id(domain))
+            .unwrap();
+    let node = ctx
+        .new_node(
+            ros2_client::NodeName::new("/", name).unwrap(),
+            ros2_client::NodeOptions::new().enable_rosout(false),
+        )
+        .unwrap();
+    (ctx, node)
+}
