@@ -30,12 +30,7 @@ fn cyclonedds_peer_drives_the_node_and_reads_its_outputs() {
     }
     assert!(v["counts"]["diagnostics"].as_u64().unwrap() >= 2);
     // Stamps are the simulation time of the state on the input's time base, in order, at 20 Hz.
-    let times: Vec<f64> = v["wrench_times"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t.as_f64().unwrap())
-        .collect();
+    let times = wrench_times(&v);
     assert!(times.windows(2).all(|w| w[1] > w[0]));
     assert!(
         times[0].abs() < 1e-3 && (times[times.len() - 1] - 2.0).abs() < 0.03,
@@ -180,12 +175,7 @@ fn cyclonedds_peer_lists_gets_and_sets_the_node_parameters() {
         .unwrap()
         .contains("'dimension'"));
     // The outputs: 20 Hz before the set, 10 Hz after it (stamps on the input's time base, t0 removed).
-    let times: Vec<f64> = v["wrench_times"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t.as_f64().unwrap())
-        .collect();
+    let times = wrench_times(&v);
     let set_at = p["set_at"].as_f64().unwrap();
     let gaps = |from: f64, to: f64| -> Vec<f64> {
         times
@@ -257,4 +247,14 @@ fn node_and_peer(
         "slosh node failed: {node_status}"
     );
     v
+}
+
+/// The stamps of the wrenches the peer received (s on the input's time base, its t0 removed).
+fn wrench_times(v: &serde_json::Value) -> Vec<f64> {
+    v["wrench_times"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect()
 }

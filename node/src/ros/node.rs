@@ -549,9 +549,11 @@ pub fn run(
             srv_qos.clone(),
         )
         .map_err(|e| anyhow::anyhow!("service ~/pause: {e:?}"))?;
+    // Every parameter as the node runs with it: the parameter services' table and the recording's metadata.
+    let effective = cfg.effective_parameters(&params);
     let mut param_srv = ParameterServers::new(&mut node, &names, mapping, &srv_qos)?;
     let mut param_table = Parameters::new(
-        &cfg.effective_parameters(&params),
+        &effective,
         c.realtime.mode == RealtimeMode::FollowClock,
         c.particles.rate_hz > 0.0,
     );
@@ -593,10 +595,7 @@ pub fn run(
     let mut recorder = if c.record.path.is_empty() {
         None
     } else {
-        let mut meta = crate::record::parameters_metadata(
-            &recorded_parameters,
-            &cfg.effective_parameters(&params),
-        );
+        let mut meta = crate::record::parameters_metadata(&recorded_parameters, &effective);
         if let Some(v) = &choice_record {
             meta.insert("auto_resolution".into(), v.to_string());
         }
