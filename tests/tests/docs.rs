@@ -450,3 +450,50 @@ fn the_parameter_reference_names_every_parameter_and_only_those() {
         "only {checked} defaults read from the tables"
     );
 }
+
+/// Every validation page shows the numbers of each case it draws as the validation command wrote them: a
+/// `<!-- results:NAME:begin -->` block with a table (a header and at least one row) for every figure of
+/// `docs/src/images/validation` (a case's second figure, `*_pressure`, shares its case's block), and no block
+/// without its figure.
+#[test]
+fn each_validation_figure_has_its_generated_numbers() {
+    let dir = root().join("docs/src/validation");
+    let mut blocks = std::collections::BTreeSet::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut rest = text.as_str();
+        while let Some(a) = rest.find("<!-- results:") {
+            let tail = &rest[a + "<!-- results:".len()..];
+            let name = tail
+                .split(":begin -->")
+                .next()
+                .filter(|n| !n.contains(char::is_whitespace))
+                .unwrap_or_else(|| panic!("{}: a results marker without :begin", path.display()));
+            let end = format!("<!-- results:{name}:end -->");
+            let b = tail
+                .find(&end)
+                .unwrap_or_else(|| panic!("{}: no {end}", path.display()));
+            let table: Vec<&str> = tail[..b].lines().filter(|l| l.starts_with('|')).collect();
+            assert!(
+                table.len() >= 3 && table[1].starts_with("|---"),
+                "{}: the results of {name} hold no table: run the validation command with SLOSH_UPDATE_DOCS=1",
+                path.display()
+            );
+            assert!(
+                blocks.insert(name.to_string()),
+                "{name}: two results blocks"
+            );
+            rest = &tail[b + end.len()..];
+        }
+    }
+    let figures: std::collections::BTreeSet<String> =
+        std::fs::read_dir(root().join("docs/src/images/validation"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "png"))
+            .map(|p| p.file_stem().unwrap().to_string_lossy().to_string())
+            .filter(|n| !n.ends_with("_pressure"))
+            .collect();
+    assert_eq!(blocks, figures, "results blocks against validation figures");
+}

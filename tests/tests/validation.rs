@@ -75,6 +75,151 @@ fn figure_panels(name: &str, title: &str, panels: Vec<Panel>) -> Vec<PathBuf> {
     files
 }
 
+/// One compared number of a validation case.
+struct Row {
+    quantity: String,
+    simulated: String,
+    reference: String,
+    /// The bound, in words ("printed, not asserted" where there is none).
+    bound: String,
+    /// Whether the bound holds (None: no bound).
+    ok: Option<bool>,
+}
+
+/// The numbers of one validation case (`name`, as its figure): each simulated quantity beside what it is
+/// compared with and the bound it is held to. [`Results::publish_and_check`] writes them as a table into
+/// `target/validation/NAME.md` and, with SLOSH_UPDATE_DOCS=1, into the manual's page `page` between the
+/// case's markers (`<!-- results:NAME:begin -->`), then fails on every bound that does not hold.
+struct Results {
+    name: String,
+    page: &'static str,
+    run: String,
+    rows: Vec<Row>,
+    started: std::time::Instant,
+}
+
+/// One case at a time rewrites a page (the cases run in parallel, several to a page).
+static DOCS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+impl Results {
+    /// `run`: what was run, in words (scheme, spacing, span); `started`: when the case started.
+    fn new(name: &str, page: &'static str, run: &str, started: std::time::Instant) -> Self {
+        Self {
+            name: name.into(),
+            page,
+            run: run.into(),
+            rows: vec![],
+            started,
+        }
+    }
+
+    fn row(
+        &mut self,
+        quantity: &str,
+        simulated: String,
+        reference: String,
+        bound: &str,
+        ok: Option<bool>,
+    ) {
+        self.rows.push(Row {
+            quantity: quantity.into(),
+            simulated,
+            reference,
+            bound: bound.into(),
+            ok,
+        });
+    }
+
+    /// The table, with where and when it was measured.
+    fn markdown(&self) -> String {
+        let shell = |cmd: &[&str]| {
+            std::process::Command::new(cmd[0])
+                .args(&cmd[1..])
+                .output()
+                .ok()
+                .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+                .filter(|s| !s.is_empty())
+                .unwrap_or_else(|| "unknown".into())
+        };
+        let cpu = std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|c| {
+                c.lines()
+                    .find(|l| l.starts_with("model name"))
+                    .and_then(|l| l.split(':').nth(1))
+                    .map(|m| m.trim().to_string())
+            })
+            .unwrap_or_else(|| "unknown CPU".into());
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let mut t = format!(
+            "{}: measured by the validation command on {} ({threads} threads), {}, commit {}, in {:.0} s.\n\n",
+            self.run,
+            cpu,
+            shell(&["date", "-u", "+%Y-%m-%d"]),
+            shell(&["git", "rev-parse", "--short", "HEAD"]),
+            self.started.elapsed().as_secs_f64()
+        );
+        t.push_str("| quantity | simulated | reference | bound | |\n|---|---|---|---|---|\n");
+        for r in &self.rows {
+            let mark = match r.ok {
+                Some(true) => "pass",
+                Some(false) => "**fails**",
+                None => "",
+            };
+            t.push_str(&format!(
+                "| {} | {} | {} | {} | {mark} |\n",
+                r.quantity, r.simulated, r.reference, r.bound
+            ));
+        }
+        t
+    }
+
+    /// Writes the table (see [`Results`]), then asserts every bound.
+    fn publish_and_check(self) {
+        let table = self.markdown();
+        let dir = std::env::var("SLOSH_VALIDATION_OUT")
+            .map(PathBuf::from)
+            .unwrap_or_else(|_| {
+                PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/validation")
+            });
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join(format!("{}.md", self.name)), &table).unwrap();
+        eprintln!("{}\n{table}", self.name);
+        if std::env::var_os("SLOSH_UPDATE_DOCS").is_some() {
+            let _one = DOCS.lock().unwrap_or_else(|e| e.into_inner());
+            let page = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../docs/src/validation")
+                .join(self.page);
+            let text = std::fs::read_to_string(&page).unwrap();
+            let (begin, end) = (
+                format!("<!-- results:{}:begin -->\n", self.name),
+                format!("<!-- results:{}:end -->", self.name),
+            );
+            let a = text
+                .find(&begin)
+                .unwrap_or_else(|| panic!("{}: no {begin}", page.display()))
+                + begin.len();
+            let b = text[a..]
+                .find(&end)
+                .unwrap_or_else(|| panic!("{}: no {end}", page.display()))
+                + a;
+            std::fs::write(&page, format!("{}{table}{}", &text[..a], &text[b..])).unwrap();
+        }
+        let failed: Vec<String> = self
+            .rows
+            .iter()
+            .filter(|r| r.ok == Some(false))
+            .map(|r| {
+                format!(
+                    "{}: {} against {} ({})",
+                    r.quantity, r.simulated, r.reference, r.bound
+                )
+            })
+            .collect();
+        assert!(failed.is_empty(), "{}: {}", self.name, failed.join("; "));
+    }
+}
+
 fn series(label: &str, t: &[f64], y: &[f64], reference: bool) -> Series {
     Series {
         label: label.to_string(),
@@ -182,6 +327,7 @@ fn faltinsen_2000_forced_sway_elevation_near_the_wall_dfsph() {
 /// 32 mm at 1.3 s, against linear theory (first 1.5 s) and the record (0–7 s), with `overrides` on top of
 /// dp 20 mm; draws the figure `name`. The simulated rms over the record's must lie in `rms_ratio`.
 fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str, rms_ratio: std::ops::Range<f64>) {
+    let started = std::time::Instant::now();
     let exp = table(&read(
         "faltinsen2000_sway/faltinsen_etal_2000_fig7_h0.6_T1.3.csv",
     ));
@@ -209,7 +355,6 @@ fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str, rms_ratio: std::
         rms(&lin),
         100.0 * lin_err
     );
-    assert!(lin_err < 0.15, "differs from linear theory by {lin_err}");
 
     // 2. Experiment (0-7 s): the crests and troughs come at the measured times (correlation), and the
     //    elevation has the measured size within the bound documented in the manual's validation page: the simulation is about
@@ -241,11 +386,41 @@ fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str, rms_ratio: std::
             series("linear potential theory", &t, &lin_all, true),
         ],
     );
-    assert!(corr > 0.9, "correlation with the measured record {corr}");
-    assert!(
-        rms_ratio.contains(&ratio),
-        "rms ratio {ratio}, bounds {rms_ratio:?}"
+    let mut r = Results::new(
+        name,
+        "faltinsen2000.md",
+        &format!("{scheme}, dp 20 mm, 0-{t_end} s"),
+        started,
     );
+    r.row(
+        "elevation over 0-1.5 s, rms difference from linear theory",
+        format!("{:.0} %", 100.0 * lin_err),
+        format!("linear theory, rms {:.1} mm", 1000.0 * rms(&lin)),
+        "< 15 %",
+        Some(lin_err < 0.15),
+    );
+    r.row(
+        "correlation with the record, 0-7 s",
+        format!("{corr:.3}"),
+        "1".into(),
+        "> 0.9",
+        Some(corr > 0.9),
+    );
+    r.row(
+        "rms over the record's rms, 0-7 s",
+        format!("{ratio:.2}"),
+        "1".into(),
+        &format!("{:.2}-{:.2}", rms_ratio.start, rms_ratio.end),
+        Some(rms_ratio.contains(&ratio)),
+    );
+    r.row(
+        "highest elevation",
+        format!("{max_sim:.3} m"),
+        format!("{max_exp:.3} m"),
+        "printed, not asserted",
+        None,
+    );
+    r.publish_and_check();
 }
 
 #[test]
@@ -271,6 +446,8 @@ fn spheric10_sensor1_impacts_come_at_the_measured_times_dfsph() {
 /// come within 0.1 s of the measured ones and the slow pressure between impacts within 25 %; `overrides` on
 /// top of dp 8 mm; draws the figure `name`.
 fn spheric10(overrides: &[&str], name: &str, label: &str) {
+    let started = std::time::Instant::now();
+    let mut r = Results::new(name, "spheric10.md", &format!("{label}, 0-6 s"), started);
     let rows = table(&read("spheric10_dualsphysics/CaseSloshingMotionData.dat"));
     // The measured roll law (degrees) turns the tank about its y axis: pitch in the tank frame.
     // 20 kHz: keep every 20th sample (1 kHz) for the spline.
@@ -332,12 +509,22 @@ fn spheric10(overrides: &[&str], name: &str, label: &str) {
             .map(|r| r[1])
             .fold(f64::MIN, f64::max);
         eprintln!("SPHERIC 10 ({label}) impact near {t_peak} s: simulated peak {ps:.0} Pa at {ts:.3} s, measured {pe:.0} Pa");
-        assert!(
-            (ts - t_peak).abs() < 0.1,
-            "simulated impact at {ts} s, measured at {t_peak} s"
+        r.row(
+            &format!("impact near {t_peak} s: time"),
+            format!("{ts:.3} s"),
+            format!("{t_peak:.3} s"),
+            "± 0.1 s",
+            Some((ts - t_peak).abs() < 0.1),
         );
         // Magnitudes are printed, not asserted: repetitions scatter by tens of percent, and single-sample
-        // WCSPH spikes here reach 5-11x the measured peaks (a known gap on issue 2).
+        // spikes reach several times the measured peaks.
+        r.row(
+            &format!("impact near {t_peak} s: peak (one sample)"),
+            format!("{:.1} kPa", ps / 1000.0),
+            format!("{:.1} kPa", pe / 1000.0),
+            "printed, not asserted",
+            None,
+        );
     }
     // Between impacts the pressure is the slow part of the flow, which the record resolves well: the
     // sensor's mean over the rise before the first impact and over the run-up after it.
@@ -353,11 +540,15 @@ fn spheric10(overrides: &[&str], name: &str, label: &str) {
     for (lo, hi) in [(0.6, 1.2), (2.45, 2.85)] {
         let (ms, me) = (mean_in(&t, &p, lo, hi), mean_in(&te, &pe, lo, hi));
         eprintln!("SPHERIC 10 ({label}) mean pressure {lo}-{hi} s: simulated {ms:.0} Pa, measured {me:.0} Pa");
-        assert!(
-            (ms - me).abs() < 0.25 * me,
-            "mean pressure {lo}-{hi} s: simulated {ms} Pa, measured {me} Pa"
+        r.row(
+            &format!("mean pressure {lo}-{hi} s"),
+            format!("{ms:.0} Pa"),
+            format!("{me:.0} Pa"),
+            "± 25 %",
+            Some((ms - me).abs() < 0.25 * me),
         );
     }
+    r.publish_and_check();
 }
 
 /// Akyildiz & Unal (2006), fig. 5, with the incompressible scheme at the case's 20 mm spacing, 0-10 s.
@@ -404,6 +595,7 @@ fn correlation(a: &[f64], b: &[f64]) -> f64 {
 /// offset of the digitised figure: it is where the simulated probe 8 is dry), so the simulated mean is checked
 /// against hydrostatics instead (within 5 %).
 fn akyildiz_2006(overrides: &[&str], t_end: f64, name: &str, label: &str, corr8: f64, p2p8: f64) {
+    let started = std::time::Instant::now();
     let cfg = config::load("akyildiz2006_pitch", &[]).unwrap();
     let motion = slosh_node::motion_source::build(&cfg).unwrap();
     let obs = observe(
@@ -474,23 +666,39 @@ fn akyildiz_2006(overrides: &[&str], t_end: f64, name: &str, label: &str, corr8:
         "Akyildiz & Unal (2006): wall pressure in a 3D tank pitched 4 degrees at 2 rad/s",
         drawn,
     );
+    let mut r = Results::new(
+        name,
+        "akyildiz2006.md",
+        &format!("{label}, 0-{t_end} s"),
+        started,
+    );
     for (probe, .., corr, ratio, m, (c_min, r_tol)) in &panels {
-        assert!(
-            *corr > *c_min,
-            "{probe}: correlation {corr} (at least {c_min})"
+        r.row(
+            &format!("{probe}: correlation with the record"),
+            format!("{corr:.3}"),
+            "1".into(),
+            &format!("> {c_min}"),
+            Some(*corr > *c_min),
         );
-        assert!(
-            (ratio - 1.0).abs() < *r_tol,
-            "{probe}: peak to peak {ratio} x the measured (within {r_tol})"
+        r.row(
+            &format!("{probe}: peak to peak over the record's"),
+            format!("{ratio:.2}"),
+            "1".into(),
+            &format!("± {:.0} %", 100.0 * r_tol),
+            Some((ratio - 1.0).abs() < *r_tol),
         );
         if *probe == "probe2" {
             let hydro = 1000.0 * 9.81 * (0.465 - 0.17) / 1000.0;
-            assert!(
-                (m - hydro).abs() < 0.05 * hydro,
-                "probe 2's mean {m} kPa, hydrostatic {hydro} kPa"
+            r.row(
+                "probe2: mean pressure",
+                format!("{m:.3} kPa"),
+                format!("{hydro:.3} kPa (hydrostatic)"),
+                "± 5 %",
+                Some((m - hydro).abs() < 0.05 * hydro),
             );
         }
     }
+    r.publish_and_check();
 }
 
 /// Bouscasse et al. (2013), series 5, with the incompressible scheme at the case's 3 mm spacing.
@@ -509,6 +717,7 @@ fn bouscasse_2013_shallow_water_bores_dfsph() {
 /// shape (correlation > 0.9, rms within 25 %), and each of the three bores arriving (the rise through 2 cm)
 /// within 0.05 T of the measured time with its crest within 25 % of the measured height.
 fn bouscasse_2013(overrides: &[&str], name: &str, label: &str) {
+    let started = std::time::Instant::now();
     let period = 2.99929;
     let exp = table(&read(
         "bouscasse2013_shallow/bouscasse_etal_2013_series5_fig19.csv",
@@ -580,23 +789,48 @@ fn bouscasse_2013(overrides: &[&str], name: &str, label: &str) {
         "Bouscasse 2013 ({label}) bores (t/T, crest m): simulated {simulated:.3?}, measured {measured:.3?}"
     );
     assert_eq!(measured.len(), 3, "the record's three bores");
+    let mut r = Results::new(
+        name,
+        "bouscasse2013.md",
+        &format!("{label}, t/T = 0-11"),
+        started,
+    );
     for (tm, cm) in &measured {
         let (tsim, csim) = simulated
             .iter()
             .min_by(|a, b| (a.0 - tm).abs().total_cmp(&(b.0 - tm).abs()))
             .copied()
             .unwrap_or_else(|| panic!("no simulated bore"));
-        assert!(
-            (tsim - tm).abs() < 0.05,
-            "bore at t/T = {tsim}, measured {tm}"
+        r.row(
+            &format!("bore near t/T = {tm:.2}: arrival (t/T)"),
+            format!("{tsim:.3}"),
+            format!("{tm:.3}"),
+            "± 0.05",
+            Some((tsim - tm).abs() < 0.05),
         );
-        assert!(
-            (csim - cm).abs() < 0.25 * cm,
-            "bore near t/T = {tm}: crest {csim} m, measured {cm} m"
+        r.row(
+            &format!("bore near t/T = {tm:.2}: crest"),
+            format!("{:.1} mm", 1000.0 * csim),
+            format!("{:.1} mm", 1000.0 * cm),
+            "± 25 %",
+            Some((csim - cm).abs() < 0.25 * cm),
         );
     }
-    assert!(corr > 0.9, "correlation with the record {corr}");
-    assert!((0.75..1.25).contains(&ratio), "rms ratio {ratio}");
+    r.row(
+        "correlation with the record",
+        format!("{corr:.3}"),
+        "1".into(),
+        "> 0.9",
+        Some(corr > 0.9),
+    );
+    r.row(
+        "rms over the record's rms",
+        format!("{ratio:.2}"),
+        "1".into(),
+        "0.75-1.25",
+        Some((0.75..1.25).contains(&ratio)),
+    );
+    r.publish_and_check();
 }
 
 /// SPHERIC Test 2 (Kleefsman et al. 2005): the 3D dam break onto a box fixed to the floor (`obstacles`), with
@@ -607,6 +841,7 @@ fn bouscasse_2013(overrides: &[&str], name: &str, label: &str) {
 /// and mean after the impact (1-6 s, within 20 %), and the impact on P1-P4 within 0.03 s.
 #[test]
 fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
+    let started = std::time::Instant::now();
     let rows = table(&read("kleefsman_spheric2/test_case_2_exp_data.dat"));
     assert!(rows.len() > 7000, "expected the 7395 rows");
     let t_end = 6.0;
@@ -658,19 +893,40 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
             ..Default::default()
         });
         let tol = if k == 2 { 0.15 } else { 0.05 };
-        checks.push((name.to_string(), corr, ratio, a_sim - a_exp, tol));
+        checks.push((name.to_string(), corr, ratio, (a_sim, a_exp), tol));
     }
     figure_panels(
         "kleefsman2005_dambreak_dfsph",
         "SPHERIC Test 2 (Kleefsman et al. 2005): 3D dam break onto a box, water heights",
         panels,
     );
-    for (name, corr, ratio, late, tol) in checks {
-        assert!(corr > 0.85, "{name}: correlation {corr}");
-        assert!((ratio - 1.0).abs() < 0.25, "{name}: rms ratio {ratio}");
-        assert!(
-            late.abs() < tol,
-            "{name}: front {late} s after the measured one (within {tol})"
+    let mut r = Results::new(
+        "kleefsman2005_dambreak_dfsph",
+        "kleefsman2005.md",
+        "DFSPH, dp 40 mm, 0-6 s",
+        started,
+    );
+    for (name, corr, ratio, (a_sim, a_exp), tol) in checks {
+        r.row(
+            &format!("{name}: correlation with the record"),
+            format!("{corr:.3}"),
+            "1".into(),
+            "> 0.85",
+            Some(corr > 0.85),
+        );
+        r.row(
+            &format!("{name}: rms over the record's"),
+            format!("{ratio:.2}"),
+            "1".into(),
+            "± 25 %",
+            Some((ratio - 1.0).abs() < 0.25),
+        );
+        r.row(
+            &format!("{name}: the front's arrival"),
+            format!("{a_sim:.3} s"),
+            format!("{a_exp:.3} s"),
+            &format!("± {tol} s"),
+            Some((a_sim - a_exp).abs() < tol),
         );
     }
     // The box's pressure sensors: P1-P4 on its face towards the column, P5-P8 on its top.
@@ -709,25 +965,52 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
             ],
             ..Default::default()
         });
-        checks.push((name, corr, ms / me, ws - we));
+        let peaks = (
+            at.iter().cloned().fold(0.0, f64::max),
+            pe.iter().cloned().fold(0.0, f64::max),
+        );
+        checks.push((name, corr, (ms, me), (ws, we), peaks));
     }
     figure_panels(
         "kleefsman2005_dambreak_dfsph_pressure",
         "SPHERIC Test 2 (Kleefsman et al. 2005): pressure on the box, P1-P4 front, P5-P8 top",
         panels,
     );
-    for (k, (name, corr, mean, late)) in checks.into_iter().enumerate() {
-        assert!(corr > 0.8, "{name}: correlation {corr}");
-        assert!(
-            (mean - 1.0).abs() < 0.2,
-            "{name}: mean after 1 s {mean} of the record's"
+    for (k, (name, corr, (ms, me), (ws, we), (peak_s, peak_e))) in checks.into_iter().enumerate() {
+        r.row(
+            &format!("{name}: correlation with the record"),
+            format!("{corr:.3}"),
+            "1".into(),
+            "> 0.8",
+            Some(corr > 0.8),
+        );
+        r.row(
+            &format!("{name}: mean pressure after 1 s"),
+            format!("{ms:.0} Pa"),
+            format!("{me:.0} Pa"),
+            "± 20 %",
+            Some((ms / me - 1.0).abs() < 0.2),
         );
         // The front's impact on the face (P1-P4); the top gets wet in splashes first.
-        if k < 4 {
-            assert!(
-                late.abs() < 0.03,
-                "{name}: impact {late} s after the measured one"
-            );
-        }
+        let (bound, ok) = if k < 4 {
+            ("± 0.03 s", Some((ws - we).abs() < 0.03))
+        } else {
+            ("printed, not asserted", None)
+        };
+        r.row(
+            &format!("{name}: above 500 Pa from"),
+            format!("{ws:.3} s"),
+            format!("{we:.3} s"),
+            bound,
+            ok,
+        );
+        r.row(
+            &format!("{name}: peak (at the record's times)"),
+            format!("{:.1} kPa", peak_s / 1000.0),
+            format!("{:.1} kPa", peak_e / 1000.0),
+            "printed, not asserted",
+            None,
+        );
     }
+    r.publish_and_check();
 }
