@@ -3,20 +3,20 @@
 //! simulation time of the state they describe (the input's time base: output stamp = first input stamp +
 //! simulation time).
 //!
-//! The node is a loop of passes over one [`LiveNode`]; each pass, in order:
+//! The node is a loop of passes over one `LiveNode`; each pass, in order:
 //!
-//! 0. answers the services (`~/reset`, `~/pause`, the parameter services: [`services`]);
+//! 0. answers the services (`~/reset`, `~/pause`, the parameter services: `services.rs`);
 //! 1. takes the motion samples received, accepts or refuses each against the time base and the motion so
-//!    far, records them ([`intake`]);
-//! 2. until a first sample is accepted, waits for motion and says why it has none ([`LiveNode::wait_for_motion`]);
+//!    far, records them (`intake.rs`);
+//! 2. until a first sample is accepted, waits for motion and says why it has none (`LiveNode::wait_for_motion`);
 //!    in real-time mode, holds the last pose once the input has been silent for `motion_timeout_s`;
 //! 3. steps the solver up to what the input (and `/clock` when following it) allows, landing on each output
-//!    time and publishing there ([`advance`]);
+//!    time and publishing there (`advance.rs`);
 //! 4. publishes diagnostics with the node's state: waiting, running, behind real time, holding, paused
-//!    ([`report`]).
+//!    (`report.rs`).
 //!
 //! Start-up (the settings' checks, the automatic resolution, the participant and its endpoints) is
-//! [`start`]; the way out (the recording finished on every exit) is [`LiveNode::finish`].
+//! `start.rs`; the way out (the recording finished on every exit) is `LiveNode::finish`.
 
 mod advance;
 mod input;
