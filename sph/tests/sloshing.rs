@@ -6,6 +6,8 @@
 //! artificial viscosity: the setting that reaches these bounds. Bounds from physics: the period within 1 % and ζ ≤ 0.005 (small model
 //! tanks measure 0.001–0.005; laminar Stokes layers give 0.0004–0.0007 here), the steady force or moment
 //! within 10 % and 10° of theory, a tilted tank's moment within 2 % of its weight through the centroid.
+//! The shipped setting (the seed cases' `dfsph`) is held to the tilted tank's bounds too, in 2D and 3D; it
+//! does not meet the period and damping bounds (the manual's sloshing page has its convergence table).
 
 use sph::kernel::KernelKind;
 use sph::params::*;
@@ -111,5 +113,58 @@ fn a_tank_held_tilted_carries_the_weight_through_the_centroid() {
             (z - want).abs() < 0.25 * 0.008,
             "probe at {x}: {z} against {want}"
         );
+    }
+}
+
+/// The shipped incompressible setting (plain gradients, the cubic spline, α 0.02: the seed cases' `dfsph`)
+/// held tilted 5°, 2D at 8 mm and 3D at 20 mm, both seed fills: the weight through the tilted liquid's
+/// centroid within 2 % (moment and both force components) and the surface level in the world (the probes
+/// on one horizontal line within a quarter spacing). Where the surface stands is not asserted here: this
+/// setting's liquid settles 0.15–0.4 spacings below the fill (a known gap, in the manual's validation pages).
+#[test]
+fn the_shipped_setting_holds_a_tilted_tank_s_weight_through_the_centroid() {
+    let theta = 5f64.to_radians();
+    let xs = [-0.3, 0.0, 0.3];
+    for (dim, dp) in [(2, 0.008), (3, 0.02)] {
+        for fill in [0.19, 0.39] {
+            let mut p = seed_tank(dim, fill, dp);
+            p.solver.scheme = Scheme::Dfsph;
+            p.probes = xs.iter().map(|&x| probe(&format!("x{x}"), x)).collect();
+            let r = tilted(p, theta, 1.5, 0.5, 3.0).unwrap();
+            // Each probe's height above the level line through the fill (z = h + x tan θ in the tank frame).
+            let off: Vec<f64> = xs
+                .iter()
+                .zip(&r.probes)
+                .map(|(x, z)| z - (fill + x * theta.tan()))
+                .collect();
+            let mean = off.iter().sum::<f64>() / off.len() as f64;
+            eprintln!(
+                "{dim}D {dp} m, fill {fill}: moment {:.3} N·m against {:.3}, force {:?} N for a weight of {:.2} N, surface {:.2} dp from the fill",
+                r.moment, r.theory_moment, r.force, r.weight, mean / dp
+            );
+            let at = format!("{dim}D, fill {fill}");
+            assert!(
+                (r.moment / r.theory_moment - 1.0).abs() < 0.02,
+                "{at}: moment {} against {}",
+                r.moment,
+                r.theory_moment
+            );
+            assert!(
+                (r.force[0] / (r.weight * theta.sin()) - 1.0).abs() < 0.02,
+                "{at}: {:?}",
+                r.force
+            );
+            assert!(
+                (-r.force[2] / (r.weight * theta.cos()) - 1.0).abs() < 0.02,
+                "{at}: {:?}",
+                r.force
+            );
+            for (x, o) in xs.iter().zip(&off) {
+                assert!(
+                    (o - mean).abs() < 0.25 * dp,
+                    "{at}: probe at {x} stands {o} m from the level line, the others {off:?}"
+                );
+            }
+        }
     }
 }
