@@ -77,13 +77,14 @@ pub fn run(
 ) -> anyhow::Result<()> {
     let cfg = load_parameters(ros, fallback_params)?;
     let names = Names::new(ros, DEFAULT_NAME)?;
+    let params = cfg.sim_params()?;
     start::check_settings(&cfg)?;
     // Before the resolution trials, so that a signal during them stops the node cleanly too.
     let stop = crate::signals::shutdown_flag()?;
     let Some(resolution) = start::resolution(&cfg, &names, &stop)? else {
         return Ok(());
     };
-    let mut node = LiveNode::start(&cfg, &names, resolution)?;
+    let mut node = LiveNode::start(&cfg, &names, params, resolution)?;
     while !stop.load(Ordering::Relaxed) {
         if node.pass(&stop, opts.duration)? == Flow::Stop {
             break;
@@ -115,23 +116,26 @@ enum Flow {
 }
 
 /// The node's ROS 2 participant and its endpoints, and the iceoryx2 node when iceoryx2 is used.
+///
+/// (Fields drop in their order: the endpoints before the node and its participant, the iceoryx2 ports
+/// before their node.)
 struct Endpoints {
-    context: ros2_client::Context,
-    node: ros2_client::Node,
     input: Input,
     sub_accel: Option<ros2_client::Subscription<AccelStamped>>,
     /// `/clock`, in `follow_clock` mode.
     sub_clock: Option<ros2_client::Subscription<Clock>>,
     out: Publishers,
     srv: Services,
-    iox_node: Option<iceoryx2::node::Node<iceoryx2::prelude::ipc::Service>>,
     iox_ports: Option<crate::iox::OutputPorts>,
+    iox_node: Option<iceoryx2::node::Node<iceoryx2::prelude::ipc::Service>>,
     /// Resolved names: the motion input, (wrench, probes, pressures), diagnostics, static frames, clouds.
     in_topic: String,
     out_topics: [String; 3],
     diag_topic: String,
     tf_topic: String,
     cloud_topic: String,
+    node: ros2_client::Node,
+    context: ros2_client::Context,
 }
 
 /// The node's publishers.
@@ -191,13 +195,14 @@ struct LiveNode<'c> {
     cfg: &'c Loaded,
     params: sph::params::SimParams,
     full_name: String,
+    /// (Before the endpoints: on an early way out its `Drop` finishes the recording while the node is up.)
+    recorder: Option<Recorder>,
     ends: Endpoints,
     table: Parameters,
     /// What a parameter set changes while the node runs.
     live: LiveSettings,
     sim: Box<dyn sph::Solver>,
     intake: Intake,
-    recorder: Option<Recorder>,
     report: Report,
     /// Outputs at k / rate (the steps land on them), the first the state at t = 0 before any step; clouds
     /// likewise at their rate.

@@ -175,19 +175,7 @@ impl Endpoints {
                 NodeOptions::new().enable_rosout(true),
             )
             .map_err(|e| anyhow::anyhow!("cannot create the node: {e:?}"))?;
-        let iox_node = if c.input.kind == InputType::Iceoryx2 || iox.outputs || iox.particles {
-            crate::iox::check_sensors(
-                &cfg.source_name,
-                params.probes.len(),
-                params.pressure_sensors.len(),
-            )?;
-            Some(
-                crate::iox::node(&format!("slosh_{}", names.node))
-                    .map_err(|e| anyhow::anyhow!("iceoryx2 (service {:?}): {e}", iox.service))?,
-            )
-        } else {
-            None
-        };
+        let iox_node = open_iceoryx2(cfg, names, params)?;
         let (input, sub_accel) = open_input(&mut node, names, cfg, iox_node.as_ref())?;
         let out = Publishers::open(&mut node, names, cfg, params)?;
         // follow_clock: ROS time from /clock (best effort keep last 1, as rclcpp's ClockQoS; reliable
@@ -231,6 +219,27 @@ impl Endpoints {
             node,
         })
     }
+}
+
+/// The iceoryx2 node, where iceoryx2 carries the input or outputs (the probes and sensors checked against
+/// its fixed-size payloads).
+fn open_iceoryx2(
+    cfg: &Loaded,
+    names: &Names,
+    params: &sph::params::SimParams,
+) -> anyhow::Result<Option<iceoryx2::node::Node<iceoryx2::prelude::ipc::Service>>> {
+    let (c, iox) = (&cfg.config, &cfg.config.iceoryx2);
+    if !(c.input.kind == InputType::Iceoryx2 || iox.outputs || iox.particles) {
+        return Ok(None);
+    }
+    crate::iox::check_sensors(
+        &cfg.source_name,
+        params.probes.len(),
+        params.pressure_sensors.len(),
+    )?;
+    let node = crate::iox::node(&format!("slosh_{}", names.node))
+        .map_err(|e| anyhow::anyhow!("iceoryx2 (service {:?}): {e}", iox.service))?;
+    Ok(Some(node))
 }
 
 /// The motion input (`input.type`) and, where asked for, the accelerations beside a pose input.
@@ -401,14 +410,15 @@ impl Report {
 }
 
 impl<'c> LiveNode<'c> {
-    /// The node as it starts: the solver at rest, no motion yet, the recording (if any) opened.
+    /// The node as it starts with the case's `params` (its spacing as `resolution` chose it): the solver at
+    /// rest, no motion yet, the recording (if any) opened.
     pub(super) fn start(
         cfg: &'c Loaded,
         names: &Names,
+        mut params: sph::params::SimParams,
         resolution: Resolution,
     ) -> anyhow::Result<Self> {
         let c = &cfg.config;
-        let mut params = cfg.sim_params()?;
         // The recording documents the spacing run, and how it was chosen.
         let mut recorded_parameters = cfg.parameters.clone();
         if let Some(dp) = resolution.particle_spacing {
