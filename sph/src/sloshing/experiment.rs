@@ -270,6 +270,19 @@ pub struct Tilted {
     pub probes: Vec<f64>,
 }
 
+impl Tilted {
+    /// The relative errors of the weight carried through the tilted liquid's centroid: the moment against
+    /// [`Tilted::theory_moment`], the force along the tank's x against m g sin θ and the force along its z
+    /// against m g cos θ.
+    pub fn errors(&self) -> [f64; 3] {
+        [
+            self.moment / self.theory_moment - 1.0,
+            self.force[0] / (self.weight * self.theta.sin()) - 1.0,
+            -self.force[2] / (self.weight * self.theta.cos()) - 1.0,
+        ]
+    }
+}
+
 /// Pitch θ reached smoothly over `ramp` s (a half-cosine) and then held.
 struct Tilt {
     theta: f64,
