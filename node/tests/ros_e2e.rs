@@ -414,15 +414,7 @@ fn logged_node(
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let seen = Instant::now();
-    while topics.iter().any(|t| node.subscription_count(t) == 0) {
-        assert!(
-            seen.elapsed() < Duration::from_secs(30),
-            "the node never subscribed"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(300));
+    common::wait_for_node(node, topics, &[], Duration::from_millis(300));
     proc
 }
 
@@ -506,10 +498,12 @@ fn pause_and_reset_services() {
             .spawn()
             .unwrap(),
     );
-    while node.subscription_count("/motion/odom") == 0 || node.publisher_count("/wrench") == 0 {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(500));
+    common::wait_for_node(
+        &node,
+        &["/motion/odom"],
+        &["/wrench"],
+        Duration::from_millis(500),
+    );
     // Samples of a tank at rest, 50 Hz, stamps from 100 s on; `k` counts samples across the calls.
     let k = std::cell::Cell::new(0u32);
     let send = |n: u32| {
@@ -604,10 +598,12 @@ fn follow_clock_never_runs_ahead_of_ros_time() {
             .spawn()
             .unwrap(),
     );
-    while node.subscription_count("/motion/odom") == 0 || node.publisher_count("/wrench") == 0 {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(500));
+    common::wait_for_node(
+        &node,
+        &["/motion/odom"],
+        &["/wrench"],
+        Duration::from_millis(500),
+    );
     let newest = |v: &mut f64| {
         while let Ok(Some((m, _))) = wrench.take() {
             *v = v.max(m.header.stamp.as_secs_f64());
@@ -758,10 +754,12 @@ fn input_timeout_holds_the_pose_reports_error_recovers_and_sigterm_stops_cleanly
             .spawn()
             .unwrap(),
     );
-    while node.subscription_count("/motion/odom") == 0 || node.publisher_count("/wrench") == 0 {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(500));
+    common::wait_for_node(
+        &node,
+        &["/motion/odom"],
+        &["/wrench"],
+        Duration::from_millis(500),
+    );
     // (newest wrench stamp, levels and messages of the diagnostics) over a stretch of wall time.
     let watch = |secs: f64, last: &mut f64| {
         let mut states = Vec::new();

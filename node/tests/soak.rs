@@ -101,15 +101,12 @@ fn an_hour_of_faulty_motion_loses_nothing() {
     let _stalled = node
         .create_subscription::<WrenchStamped>(&stall_topic, Some(stall_qos))
         .unwrap();
-    let seen = Instant::now();
-    while node.subscription_count(&format!("{NS}/motion/odom")) == 0 {
-        assert!(
-            seen.elapsed() < Duration::from_secs(30),
-            "the node never subscribed"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(300));
+    common::wait_for_node(
+        &node,
+        &[&format!("{NS}/motion/odom")],
+        &[],
+        Duration::from_millis(300),
+    );
 
     // The samples to send: (motion time, stamp), faults included.
     let n = (seconds * RATE) as usize;
@@ -306,15 +303,12 @@ fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
         let clock = node
             .create_publisher::<Clock>(&clock_topic, Some(qos.clone()))
             .unwrap();
-        let seen = Instant::now();
-        while node.subscription_count(&format!("{NS}/motion/odom")) == 0 {
-            assert!(
-                seen.elapsed() < Duration::from_secs(30),
-                "the node never subscribed"
-            );
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        std::thread::sleep(Duration::from_millis(300));
+        common::wait_for_node(
+            &node,
+            &[&format!("{NS}/motion/odom")],
+            &[],
+            Duration::from_millis(300),
+        );
         let start = Instant::now();
         let (mut sent, mut faults) = (0u64, 0u32);
         let mut k = 0u64;

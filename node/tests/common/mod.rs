@@ -281,3 +281,25 @@ pub fn participant(domain: u16, name: &str) -> (ros2_client::Context, ros2_clien
         .unwrap();
     (ctx, node)
 }
+
+/// Waits until the node under test, as `node` (the test's participant) sees it, subscribes to every topic of
+/// `subscribed` and publishes on every topic of `published` (failing after 30 s), then `settle` more for the
+/// readers and writers to match.
+pub fn wait_for_node(
+    node: &ros2_client::Node,
+    subscribed: &[&str],
+    published: &[&str],
+    settle: std::time::Duration,
+) {
+    let seen = std::time::Instant::now();
+    while subscribed.iter().any(|t| node.subscription_count(t) == 0)
+        || published.iter().any(|t| node.publisher_count(t) == 0)
+    {
+        assert!(
+            seen.elapsed() < std::time::Duration::from_secs(30),
+            "the node never subscribed to {subscribed:?} and published {published:?}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::thread::sleep(settle);
+}
