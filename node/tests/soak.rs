@@ -204,14 +204,7 @@ fn an_hour_of_faulty_motion_loses_nothing() {
         }
     }
     // SIGINT while the node is still stepping and writing.
-    assert!(Command::new("kill")
-        .args(["-INT", &pid.to_string()])
-        .status()
-        .unwrap()
-        .success());
-    let log = stderr.join().unwrap();
-    let status = proc.0.wait().unwrap();
-    assert!(status.success(), "{status}: {log}");
+    let (_, accounted) = interrupt_and_account(&mut proc, pid, stderr, &bag, "lockstep");
     let wall = start.elapsed().as_secs_f64();
     let Accounts {
         accepted,
@@ -219,7 +212,7 @@ fn an_hour_of_faulty_motion_loses_nothing() {
         published,
         odom_in_bag,
         wrench_in_bag,
-    } = accounts(&log, &bag, "lockstep");
+    } = accounted;
     println!(
         "soak: {seconds} s of motion in {wall:.1} s wall: {sent} samples sent ({bursts} bursts, {duplicated} samples sent twice, {swapped} pairs swapped, {jumps} stamp jumps, {restarts} publisher restarts); the node took {accepted} and refused {rejected}, published {published} outputs; the bag holds {odom_in_bag} motion samples and {wrench_in_bag} wrenches"
     );
@@ -352,21 +345,15 @@ fn input_gaps_and_a_clock_that_jumps_back_lose_nothing() {
             sent += 1;
         }
         std::thread::sleep(Duration::from_millis(300));
-        assert!(Command::new("kill")
-            .args(["-INT", &proc.0.id().to_string()])
-            .status()
-            .unwrap()
-            .success());
-        let log = stderr.join().unwrap();
-        let status = proc.0.wait().unwrap();
-        assert!(status.success(), "{mode}: {status}: {log}");
+        let pid = proc.0.id();
+        let (log, accounted) = interrupt_and_account(&mut proc, pid, stderr, &bag, mode);
         let Accounts {
             accepted,
             rejected,
             published,
             odom_in_bag,
             wrench_in_bag,
-        } = accounts(&log, &bag, mode);
+        } = accounted;
         println!(
             "soak ({mode}): {seconds} s, {sent} samples sent, {faults} faults; the node took {accepted} and refused {rejected}, published {published} outputs; the bag holds {odom_in_bag} motion samples and {wrench_in_bag} wrenches"
         );
@@ -391,6 +378,27 @@ struct Accounts {
     published: u64,
     odom_in_bag: u64,
     wrench_in_bag: u64,
+}
+
+/// Stops the node `pid` (of `proc`) with SIGINT, asserts that it exits cleanly, and returns its log (read by
+/// `stderr`) with the [`accounts`] of the run (`what` names it in a failure).
+fn interrupt_and_account(
+    proc: &mut Kill,
+    pid: u32,
+    stderr: std::thread::JoinHandle<String>,
+    bag: &std::path::Path,
+    what: &str,
+) -> (String, Accounts) {
+    assert!(Command::new("kill")
+        .args(["-INT", &pid.to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let log = stderr.join().unwrap();
+    let status = proc.0.wait().unwrap();
+    assert!(status.success(), "{what}: {status}: {log}");
+    let accounted = accounts(&log, bag, what);
+    (log, accounted)
 }
 
 /// The [`Accounts`] of a run that logged `log` and recorded `bag`; asserts that both third-party readers
