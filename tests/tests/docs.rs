@@ -497,3 +497,133 @@ fn each_validation_figure_has_its_generated_numbers() {
             .collect();
     assert_eq!(blocks, figures, "results blocks against validation figures");
 }
+
+/// The numbers written in `text`, each with its decimals and whether it carries a sign: a run of digits with
+/// an optional fraction, not part of a word (`P8`, `2D`), with a sign (`+`, `-`, `−`) directly before it
+/// where that sign starts a word.
+fn numbers(text: &str) -> Vec<(f64, usize, bool)> {
+    let c: Vec<char> = text.chars().collect();
+    let word = |ch: char| ch.is_alphanumeric() || ch == '.' || ch == '_';
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < c.len() {
+        if !c[i].is_ascii_digit() || (i > 0 && word(c[i - 1])) {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < c.len() && c[i].is_ascii_digit() {
+            i += 1;
+        }
+        let mut decimals = 0;
+        if i + 1 < c.len() && c[i] == '.' && c[i + 1].is_ascii_digit() {
+            i += 1;
+            while i < c.len() && c[i].is_ascii_digit() {
+                i += 1;
+                decimals += 1;
+            }
+        }
+        if i < c.len() && c[i].is_ascii_alphabetic() {
+            continue;
+        }
+        let digits: String = c[start..i].iter().collect();
+        let mut value: f64 = digits.parse().unwrap();
+        let signed = start > 0
+            && matches!(c[start - 1], '+' | '-' | '−')
+            && (start == 1 || !word(c[start - 2]));
+        if signed && c[start - 1] != '+' {
+            value = -value;
+        }
+        out.push((value, decimals, signed));
+    }
+    out
+}
+
+/// The text of every generated block (`<!-- NAME:begin -->` … `<!-- NAME:end -->`) of a page.
+fn generated_blocks(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(a) = rest.find(":begin -->") {
+        let name_start = rest[..a].rfind("<!-- ").expect("a begin marker") + "<!-- ".len();
+        let end = format!("<!-- {}:end -->", &rest[name_start..a]);
+        let tail = &rest[a..];
+        let b = tail.find(&end).unwrap_or_else(|| panic!("no {end}"));
+        out += &tail[..b];
+        rest = &tail[b..];
+    }
+    out
+}
+
+/// The README's validation table is a summary of the manual's generated numbers: each row links to the
+/// validation page(s) it summarises, and every number in its result column is, as rounded there, a number
+/// of those pages' generated blocks (the validation command's results, the convergence and response
+/// tables), so that a rerun that moves a number fails here until the README says what the manual does.
+#[test]
+fn the_readme_validation_numbers_are_the_generated_ones() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let section = readme
+        .split("\n## Validation\n")
+        .nth(1)
+        .expect("README.md: a ## Validation section");
+    let rows: Vec<&str> = section
+        .lines()
+        .skip_while(|l| !l.starts_with('|'))
+        .take_while(|l| l.starts_with('|'))
+        .skip(2)
+        .collect();
+    assert!(rows.len() >= 5, "README.md: the validation table: {rows:?}");
+    for row in rows {
+        let cells: Vec<&str> = row.trim_matches('|').split(" | ").collect();
+        assert!(cells.len() >= 3, "README.md validation row {row}");
+        let pages: BTreeSet<String> = links(cells[0])
+            .into_iter()
+            .filter_map(|l| {
+                l.split('#')
+                    .next()
+                    .filter(|p| p.starts_with("docs/src/validation/"))
+                    .map(str::to_string)
+            })
+            .collect();
+        assert!(
+            !pages.is_empty(),
+            "README.md validation row without a link to its validation page: {row}"
+        );
+        let mut known = Vec::new();
+        for p in &pages {
+            let text = std::fs::read_to_string(root().join(p)).unwrap();
+            known.extend(numbers(&generated_blocks(&text)));
+        }
+        for (x, decimals, signed) in numbers(cells[1]) {
+            let half = 0.5 * 10f64.powi(-(decimals as i32)) + 1e-9;
+            let found = known.iter().any(|&(y, _, _)| {
+                if signed {
+                    (y - x).abs() <= half
+                } else {
+                    (y.abs() - x.abs()).abs() <= half
+                }
+            });
+            assert!(
+                found,
+                "README.md validation row: {x} is not a number of the generated tables of {pages:?} \
+                 (rerun the command that makes them, or say in the README what they say): {row}"
+            );
+        }
+    }
+}
+
+#[test]
+fn numbers_are_read_as_written() {
+    let n = numbers("P8 0.94–0.97, +3 % / −11 %, 2D 1.30× (at 20 mm) x-1");
+    assert_eq!(
+        n,
+        vec![
+            (0.94, 2, false),
+            (0.97, 2, false),
+            (3.0, 0, true),
+            (-11.0, 0, true),
+            (1.30, 2, false),
+            (20.0, 0, false),
+            (1.0, 0, false),
+        ]
+    );
+}
