@@ -86,15 +86,7 @@ fn main() {
     if quick {
         return;
     }
-    let machine = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|c| {
-            c.lines().find_map(|l| {
-                l.strip_prefix("model name")
-                    .map(|m| m.trim_start_matches([' ', '\t', ':']).to_string())
-            })
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
+    let machine = slosh_node::manual::machine();
     let threads = rayon::current_num_threads();
     let heading = format!("{machine} ({threads} threads)");
     std::fs::write(&data, csv(&heading, &rows)).unwrap();
@@ -115,10 +107,9 @@ fn write(root: &Path, rows: &[Row], heading: &str, png: Option<String>) {
     }
     let page = root.join("docs/src/validation/sloshing.md");
     let text = std::fs::read_to_string(&page).expect("docs/src/validation/sloshing.md");
-    let (begin, end) = ("<!-- convergence:begin -->\n", "<!-- convergence:end -->");
-    let a = text.find(begin).expect("the convergence:begin marker") + begin.len();
-    let b = text[a..].find(end).expect("the convergence:end marker") + a;
-    std::fs::write(&page, format!("{}{table}{}", &text[..a], &text[b..])).unwrap();
+    let text = slosh_node::manual::replace_block(&text, "convergence", &table)
+        .expect("the convergence markers");
+    std::fs::write(&page, text).unwrap();
     let svg = root.join("docs/src/images/convergence.svg");
     let fig = convergence_figure(rows);
     figure::draw(

@@ -13,6 +13,7 @@
 //! cargo run --release -p slosh-node --example sloshing_response -- --quick   # 2D dfsph only, printed only
 //! ```
 use slosh_node::accuracy::SETTINGS;
+use slosh_node::manual;
 use sph::params::{ProbeSpec, SimParams};
 use sph::sloshing::experiment::{forced, seed_tank, tilted, Forcing};
 use std::path::Path;
@@ -135,19 +136,7 @@ fn main() {
     let page = root.join("docs/src/validation/sloshing.md");
     let mut text = std::fs::read_to_string(&page).expect("docs/src/validation/sloshing.md");
     for (name, table) in [("response", &response), ("tilted", &held)] {
-        let (begin, end) = (
-            format!("<!-- {name}:begin -->\n"),
-            format!("<!-- {name}:end -->"),
-        );
-        let a = text
-            .find(&begin)
-            .unwrap_or_else(|| panic!("the {name}:begin marker"))
-            + begin.len();
-        let b = text[a..]
-            .find(&end)
-            .unwrap_or_else(|| panic!("the {name}:end marker"))
-            + a;
-        text = format!("{}{table}{}", &text[..a], &text[b..]);
+        text = manual::replace_block(&text, name, table).expect("the sloshing page's markers");
     }
     std::fs::write(&page, text).unwrap();
     println!("wrote {}", page.display());
@@ -155,28 +144,11 @@ fn main() {
 
 /// Where, when and at which commit the tables were measured.
 fn measured() -> String {
-    let machine = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|c| {
-            c.lines().find_map(|l| {
-                l.strip_prefix("model name")
-                    .map(|m| m.trim_start_matches([' ', '\t', ':']).to_string())
-            })
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
-    let shell = |cmd: &[&str]| {
-        std::process::Command::new(cmd[0])
-            .args(&cmd[1..])
-            .output()
-            .ok()
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-            .filter(|s| !s.is_empty())
-            .unwrap_or_else(|| "unknown".into())
-    };
     format!(
-        "Measured on {machine} ({} threads), {}, commit {}.",
+        "Measured on {} ({} threads), {}, commit {}.",
+        manual::machine(),
         rayon::current_num_threads(),
-        shell(&["date", "-u", "+%Y-%m-%d"]),
-        shell(&["git", "rev-parse", "--short", "HEAD"])
+        manual::today(),
+        manual::commit()
     )
 }

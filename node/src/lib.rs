@@ -11,6 +11,7 @@ pub mod cli;
 pub mod config;
 pub mod input;
 pub mod iox;
+pub mod manual;
 pub mod mcap_bounds;
 pub mod memory;
 pub mod messages;

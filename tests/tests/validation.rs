@@ -132,31 +132,13 @@ impl Results {
 
     /// The table, with where and when it was measured.
     fn markdown(&self) -> String {
-        let shell = |cmd: &[&str]| {
-            std::process::Command::new(cmd[0])
-                .args(&cmd[1..])
-                .output()
-                .ok()
-                .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-                .filter(|s| !s.is_empty())
-                .unwrap_or_else(|| "unknown".into())
-        };
-        let cpu = std::fs::read_to_string("/proc/cpuinfo")
-            .ok()
-            .and_then(|c| {
-                c.lines()
-                    .find(|l| l.starts_with("model name"))
-                    .and_then(|l| l.split(':').nth(1))
-                    .map(|m| m.trim().to_string())
-            })
-            .unwrap_or_else(|| "unknown CPU".into());
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let mut t = format!(
             "{}: measured by the validation command on {} ({threads} threads), {}, commit {}, in {:.0} s.\n\n",
             self.run,
-            cpu,
-            shell(&["date", "-u", "+%Y-%m-%d"]),
-            shell(&["git", "rev-parse", "--short", "HEAD"]),
+            slosh_node::manual::machine(),
+            slosh_node::manual::today(),
+            slosh_node::manual::commit(),
             self.started.elapsed().as_secs_f64()
         );
         t.push_str("| quantity | simulated | reference | bound | |\n|---|---|---|---|---|\n");
@@ -191,19 +173,10 @@ impl Results {
                 .join("../docs/src/validation")
                 .join(self.page);
             let text = std::fs::read_to_string(&page).unwrap();
-            let (begin, end) = (
-                format!("<!-- results:{}:begin -->\n", self.name),
-                format!("<!-- results:{}:end -->", self.name),
-            );
-            let a = text
-                .find(&begin)
-                .unwrap_or_else(|| panic!("{}: no {begin}", page.display()))
-                + begin.len();
-            let b = text[a..]
-                .find(&end)
-                .unwrap_or_else(|| panic!("{}: no {end}", page.display()))
-                + a;
-            std::fs::write(&page, format!("{}{table}{}", &text[..a], &text[b..])).unwrap();
+            let text =
+                slosh_node::manual::replace_block(&text, &format!("results:{}", self.name), &table)
+                    .unwrap_or_else(|e| panic!("{}: {e}", page.display()));
+            std::fs::write(&page, text).unwrap();
         }
         let failed: Vec<String> = self
             .rows
