@@ -222,23 +222,13 @@ fn bench_table() -> String {
 fn generated(file: &str, name: &str, body: &str) {
     let path = root().join(file);
     let text = std::fs::read_to_string(&path).unwrap();
-    let (begin, end) = (
-        format!("<!-- {name}:begin -->\n"),
-        format!("<!-- {name}:end -->"),
-    );
-    let a = text
-        .find(&begin)
-        .unwrap_or_else(|| panic!("{file}: no {begin}"))
-        + begin.len();
-    let b = text[a..]
-        .find(&end)
-        .unwrap_or_else(|| panic!("{file}: no {end}"))
-        + a;
-    if &text[a..b] == body {
+    let made = slosh_node::manual::replace_block(&text, name, body)
+        .unwrap_or_else(|e| panic!("{file}: {e}"));
+    if made == text {
         return;
     }
     if std::env::var_os("SLOSH_UPDATE_DOCS").is_some() {
-        std::fs::write(&path, format!("{}{body}{}", &text[..a], &text[b..])).unwrap();
+        std::fs::write(&path, made).unwrap();
         return;
     }
     panic!(
