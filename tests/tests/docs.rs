@@ -452,19 +452,18 @@ fn each_validation_figure_has_its_generated_numbers() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         let text = std::fs::read_to_string(&path).unwrap();
-        let mut rest = text.as_str();
-        while let Some(a) = rest.find("<!-- results:") {
-            let tail = &rest[a + "<!-- results:".len()..];
-            let name = tail
-                .split(":begin -->")
-                .next()
-                .filter(|n| !n.contains(char::is_whitespace))
-                .unwrap_or_else(|| panic!("{}: a results marker without :begin", path.display()));
-            let end = format!("<!-- results:{name}:end -->");
-            let b = tail
-                .find(&end)
-                .unwrap_or_else(|| panic!("{}: no {end}", path.display()));
-            let table: Vec<&str> = tail[..b].lines().filter(|l| l.starts_with('|')).collect();
+        let results: Vec<(&str, &str)> = generated_blocks(&text)
+            .into_iter()
+            .filter_map(|(name, body)| name.strip_prefix("results:").map(|n| (n, body)))
+            .collect();
+        assert_eq!(
+            text.matches("<!-- results:").count(),
+            2 * results.len(),
+            "{}: a results marker without its pair",
+            path.display()
+        );
+        for (name, body) in results {
+            let table: Vec<&str> = body.lines().filter(|l| l.starts_with('|')).collect();
             assert!(
                 table.len() >= 3 && table[1].starts_with("|---"),
                 "{}: the results of {name} hold no table: run the validation command with SLOSH_UPDATE_DOCS=1",
@@ -474,7 +473,6 @@ fn each_validation_figure_has_its_generated_numbers() {
                 blocks.insert(name.to_string()),
                 "{name}: two results blocks"
             );
-            rest = &tail[b + end.len()..];
         }
     }
     let figures: std::collections::BTreeSet<String> =
@@ -529,17 +527,18 @@ fn numbers(text: &str) -> Vec<(f64, usize, bool)> {
     out
 }
 
-/// The text of every generated block (`<!-- NAME:begin -->` … `<!-- NAME:end -->`) of a page.
-fn generated_blocks(text: &str) -> String {
-    let mut out = String::new();
+/// The generated blocks of a page, `<!-- NAME:begin -->` … `<!-- NAME:end -->`: each name and what stands
+/// between its markers.
+fn generated_blocks(text: &str) -> Vec<(&str, &str)> {
+    let mut out = Vec::new();
     let mut rest = text;
     while let Some(a) = rest.find(":begin -->") {
-        let name_start = rest[..a].rfind("<!-- ").expect("a begin marker") + "<!-- ".len();
-        let end = format!("<!-- {}:end -->", &rest[name_start..a]);
-        let tail = &rest[a..];
-        let b = tail.find(&end).unwrap_or_else(|| panic!("no {end}"));
-        out += &tail[..b];
-        rest = &tail[b..];
+        let name = &rest[rest[..a].rfind("<!-- ").expect("a begin marker") + "<!-- ".len()..a];
+        let end = format!("<!-- {name}:end -->");
+        let body = &rest[a + ":begin -->".len()..];
+        let b = body.find(&end).unwrap_or_else(|| panic!("no {end}"));
+        out.push((name, &body[..b]));
+        rest = &body[b..];
     }
     out
 }
@@ -581,7 +580,9 @@ fn the_readme_validation_numbers_are_the_generated_ones() {
         let mut known = Vec::new();
         for p in &pages {
             let text = std::fs::read_to_string(root().join(p)).unwrap();
-            known.extend(numbers(&generated_blocks(&text)));
+            for (_, body) in generated_blocks(&text) {
+                known.extend(numbers(body));
+            }
         }
         for (x, decimals, signed) in numbers(cells[1]) {
             let half = 0.5 * 10f64.powi(-(decimals as i32)) + 1e-9;
