@@ -9,6 +9,7 @@ pub mod bag;
 pub mod bench;
 pub mod cli;
 pub mod config;
+pub mod drive;
 pub mod input;
 pub mod iox;
 pub mod manual;

@@ -362,20 +362,18 @@ impl Drop for Recorder {
     }
 }
 
-/// Records one observed state of `slosh run`: the outputs on `/wrench`, `/probes`, `/pressures` and the
-/// motion that drove the tank on `/motion/odom`, all at the simulation time `o.time`.
+/// Records one output of `slosh run`: its messages on `/wrench`, `/probes`, `/pressures` and the tank's
+/// `motion` up to it on `/motion/odom`, all at `stamp` (the simulation time).
 pub fn record_state(
     rec: &mut Recorder,
-    params: &sph::params::SimParams,
     tank_frame: &str,
-    o: &sph::observe::Observation,
-    motion: &dyn sph::motion::TankMotion,
+    stamp: Time,
+    m: &crate::messages::OutputMessages,
+    motion: &sph::motion::RigidState,
 ) -> Result<(), RecordError> {
-    let stamp = slosh_msgs::builtin_interfaces::Time::from_secs_f64(o.time);
-    let m = crate::messages::output_messages(params, tank_frame, stamp, o);
-    let odom = crate::messages::motion::odometry(&motion.state(o.time), stamp, "world", tank_frame);
+    let odom = crate::messages::motion::odometry(motion, stamp, "world", tank_frame);
     rec.write("/motion/odom", stamp, &odom)?;
-    rec.write_outputs(&output_topics(), stamp, &m)
+    rec.write_outputs(&output_topics(), stamp, m)
 }
 
 /// The topics `slosh run` and `slosh replay` record the outputs on: wrench, probes, pressures.

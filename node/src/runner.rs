@@ -3,10 +3,11 @@
 
 use crate::config::Loaded;
 use crate::config::RecordCfg;
+use crate::drive::{deliver_frame, DriveError, Grid, Outputs};
 use crate::motion_source;
 use crate::output::{write_summary, CsvOutputs, Summary};
 use crate::record::{record_state, RecordError, Recorder};
-use crate::sinks::{RecordState, Recording, Sink, SinkError};
+use crate::sinks::{FrameSink, Output, RecordState, Recording, Sink, SinkError, TimeBase};
 use crate::snapshot::{SnapshotOptions, SnapshotWriter};
 use indicatif::{ProgressBar, ProgressStyle};
 use sph::motion::TankMotion;
@@ -61,6 +62,8 @@ pub struct Drive<'a> {
     /// The recording to create once the run's options are checked (None: off), and how one state is
     /// recorded.
     pub record: Option<(RecordCfg, &'a mut RecordState<'a>)>,
+    /// How the recorded outputs are stamped (a run: its simulation time; a replay: on the bag's time base).
+    pub time_base: TimeBase,
     /// Extra facts for `summary.json` (e.g. where a replay's motion came from).
     pub input: Option<serde_json::Value>,
     /// Called once the run's options are checked and its outputs created, before the first step (a
@@ -77,11 +80,18 @@ pub fn run(
     opts: &RunOptions,
     announce: impl FnOnce(),
 ) -> Result<Summary, RunError> {
-    let params = cfg.sim_params()?;
+    // The case's errors are said before the motion's.
+    cfg.sim_params()?;
     let motion = motion_source::build(cfg)?;
     let frame = cfg.config.frames.tank.clone();
-    let mut record = |r: &mut Recorder, o: &sph::observe::Observation| {
-        record_state(r, &params, &frame, o, motion.as_ref())
+    let mut record = |r: &mut Recorder, out: &Output| {
+        record_state(
+            r,
+            &frame,
+            out.stamp,
+            out.messages,
+            &out.motion.state(out.observation.time),
+        )
     };
     drive(
         cfg,
@@ -92,6 +102,7 @@ pub fn run(
             motion: motion.as_ref(),
             record: (!cfg.config.record.path.is_empty())
                 .then(|| (cfg.config.record.clone(), &mut record as &mut RecordState)),
+            time_base: TimeBase::Seconds(0.0),
             input: None,
         },
     )
@@ -168,12 +179,12 @@ pub fn drive(
         Some((rc, f)) => Some((Recorder::create(&rc, &parameters, &effective)?, f)),
         None => None,
     };
-    let mut outputs = CsvOutputs::create(out, &params, opts.snapshots.is_some())?;
-    if !outputs.replaced.is_empty() {
+    let mut csv = CsvOutputs::create(out, &params, opts.snapshots.is_some())?;
+    if !csv.replaced.is_empty() {
         eprintln!(
             "{}: removed what an earlier run there left and this one would not replace: {}",
             out.display(),
-            outputs.replaced.join(", ")
+            csv.replaced.join(", ")
         );
     }
     let mut snapshots = match &opts.snapshots {
@@ -195,17 +206,19 @@ pub fn drive(
         recorder: r,
         record: &mut **f,
     });
-    let mut sinks: Vec<&mut dyn Sink> = vec![&mut outputs];
+    let mut sinks: Vec<&mut dyn Sink> = vec![&mut csv];
     sinks.extend(recording.as_mut().map(|r| r as &mut dyn Sink));
+    let mut outputs = Outputs::new(cfg.config.output_rate_hz, &params, &cfg.config.frames.tank);
     let result = run_loop(
         sim.as_mut(),
         motion,
+        &mut outputs,
+        d.time_base,
         &mut sinks,
-        snapshots.as_mut().map(|(w, hz)| (w, *hz)),
+        snapshots.as_mut().map(|(w, hz)| (w, Grid::new(*hz))),
         &stop,
         Pace {
             duration,
-            output_rate: cfg.config.output_rate_hz,
             speed: opts.rate,
         },
         &bar,
@@ -215,7 +228,7 @@ pub fn drive(
     bar.finish_and_clear();
     // The CSVs are flushed and the bag finished on every path, also when the solver stopped; the first
     // failure is the one reported (a bag that failed to write usually fails to finish too).
-    let flushed = outputs.close();
+    let flushed = csv.close();
     let recording = record.as_ref().map(|(r, _)| r.dir().display().to_string());
     let finished = record.map_or(Ok(()), |(mut r, _)| r.finish());
     let snapshot_info = snapshots.map(|(w, hz)| {
@@ -313,43 +326,41 @@ enum LoopError {
 struct Pace {
     /// Simulated seconds.
     duration: f64,
-    /// Output rows per simulated second.
-    output_rate: f64,
     /// Simulated seconds per wall-clock second at most.
     speed: Option<f64>,
 }
 
-/// Steps the solver to each output time and hands every observation to the `sinks`, and the particle frames
+/// Steps the solver to each output time and hands every output to the `sinks`, and the particle frames
 /// (with their rate) to `snap`, until the duration or a stop.
+#[allow(clippy::too_many_arguments)]
 fn run_loop(
     sim: &mut dyn Solver,
     motion: &dyn TankMotion,
+    outputs: &mut Outputs,
+    base: TimeBase,
     sinks: &mut [&mut dyn Sink],
-    mut snap: Option<(&mut SnapshotWriter, f64)>,
+    mut snap: Option<(&mut SnapshotWriter, Grid)>,
     stop: &std::sync::atomic::AtomicBool,
     pace: Pace,
     bar: &ProgressBar,
 ) -> Result<(), LoopError> {
-    let (duration, rate) = (pace.duration, pace.output_rate);
-    let (mut k, mut j) = (0u64, 0u64);
+    let duration = pace.duration;
     let start = Instant::now();
     let mut last_draw = Instant::now();
     let mut last_flush = Instant::now();
     loop {
         let t = sim.time();
-        if t >= k as f64 / rate - 1e-9 {
-            let o = sim.observe(motion).map_err(LoopError::Solver)?;
-            for s in sinks.iter_mut() {
-                s.observed(&o, motion).map_err(|e| at(t, e))?;
-            }
-            k = (t * rate + 1e-9).floor() as u64 + 1;
-        }
-        if let Some((w, hz)) = snap.as_mut() {
-            if t >= j as f64 / *hz - 1e-9 {
-                w.send(sim.snapshot(), motion.state(t))
-                    .map_err(LoopError::Io)?;
-                j = (t * *hz + 1e-9).floor() as u64 + 1;
-            }
+        outputs
+            .deliver(sim, motion, base, sinks)
+            .map_err(|e| match e {
+                DriveError::Solver(e) => LoopError::Solver(e),
+                DriveError::Sink(e) => at(t, e),
+            })?;
+        // Frames change nothing the run computes: they are the first state at or after their times, which is
+        // theirs exactly where their rate divides the output rate.
+        if let Some((w, times)) = snap.as_mut() {
+            deliver_frame(times, sim, motion, base, &mut [*w as &mut dyn FrameSink])
+                .map_err(|e| at(t, e))?;
         }
         if t >= duration - 1e-9 {
             return Ok(());
@@ -357,11 +368,8 @@ fn run_loop(
         if stop.load(std::sync::atomic::Ordering::Relaxed) {
             return Err(LoopError::Interrupted(t));
         }
-        // Steps land on the next output time and on the end: outputs come at exactly k / rate (the
-        // incompressible scheme's steps are milliseconds long). Not on snapshot times: frames change nothing
-        // the run computes (they are the first state at or after their times, which is theirs exactly where
-        // their rate divides the output rate).
-        sim.step_to(motion, (k as f64 / rate).min(duration))
+        outputs
+            .step(sim, motion, duration)
             .map_err(LoopError::Solver)?;
         if let Some(speed) = pace.speed {
             let ahead = sim.time() / speed - start.elapsed().as_secs_f64();
@@ -392,6 +400,9 @@ fn at(t: f64, e: SinkError) -> LoopError {
             format!("writing the outputs at t = {t:.4} s: {e}"),
         )),
         SinkError::Record(e) => LoopError::Record(e),
+        SinkError::Send(e) => LoopError::Io(std::io::Error::other(format!(
+            "sending the outputs at t = {t:.4} s: {e}"
+        ))),
     }
 }
 

@@ -167,3 +167,24 @@ impl OutputPorts {
         Ok(())
     }
 }
+
+/// The outputs over iceoryx2, with the solver steps since the previous output.
+impl crate::sinks::Sink for OutputPorts {
+    fn observed(&mut self, out: &crate::sinks::Output) -> Result<(), crate::sinks::SinkError> {
+        let mut o = outputs_of(out.seconds, out.observation);
+        o.steps = out.steps as u32;
+        Ok(self.publish(&o)?)
+    }
+}
+
+/// Particle frames over iceoryx2.
+impl crate::sinks::FrameSink for OutputPorts {
+    fn frame(
+        &mut self,
+        sim: &dyn sph::Solver,
+        _: &dyn sph::motion::TankMotion,
+        base: crate::sinks::TimeBase,
+    ) -> Result<(), crate::sinks::SinkError> {
+        Ok(self.publish_particles(base.seconds(sim.time()), &sim.snapshot())?)
+    }
+}

@@ -12,7 +12,7 @@ use crate::input::gravity_check::{GravityCheck, InputKind};
 use crate::output::Summary;
 use crate::record::{output_topics, Recorder};
 use crate::runner::{drive, Drive, RunError, RunOptions};
-use crate::sinks::RecordState;
+use crate::sinks::{Output, RecordState, TimeBase};
 use slosh_msgs::builtin_interfaces::Time;
 use std::path::Path;
 
@@ -118,12 +118,11 @@ pub fn replay(
         recording: record_cfg.path.clone(),
         input_check,
     };
-    let tank_frame = c.frames.tank.clone();
     let topics = output_topics();
     let mut next = 0;
-    let mut record = |r: &mut Recorder, o: &sph::observe::Observation| {
+    let mut record = |r: &mut Recorder, out: &Output| {
         // The motion that drove the tank up to this state, as recorded, then the outputs.
-        let stamp_ns = bm.t0_ns + (o.time * 1e9).round() as i64;
+        let stamp_ns = out.stamp.as_nanos();
         while let Some((t, data)) = bm.messages.get(next).filter(|m| m.0 <= stamp_ns) {
             r.write_raw(
                 &bm.topic,
@@ -134,9 +133,7 @@ pub fn replay(
             )?;
             next += 1;
         }
-        let stamp = Time::from_nanos(stamp_ns);
-        let m = crate::messages::output_messages(&params, &tank_frame, stamp, o);
-        r.write_outputs(&topics, stamp, &m)
+        r.write_outputs(&topics, out.stamp, out.messages)
     };
     let run = RunOptions {
         duration: Some(opts.duration.unwrap_or(span)),
@@ -152,6 +149,7 @@ pub fn replay(
         Drive {
             motion: bm.motion.as_ref(),
             record: Some((record_cfg, &mut record as &mut RecordState)),
+            time_base: TimeBase::Nanos(bm.t0_ns),
             input: Some(input),
             // Said once the outputs exist: a replay refused by its options writes nothing and says so.
             started: Some(Box::new(|| announce(&found))),

@@ -1,10 +1,9 @@
 //! Stepping: the solver advances up to what the input allows (the newest sample less
 //! `input.delay_samples`, and in `follow_clock` mode not past `/clock`), each step landing on the next
-//! output time, where the outputs are published, recorded and sent over iceoryx2; then the pacing is
-//! noted against real time.
+//! output time, where the outputs go to the node's sinks (`outputs.rs`); then the pacing is noted against
+//! real time.
 
 use super::LiveNode;
-use crate::messages::output_messages;
 use crate::ros::publish;
 use ros2_client::ros2::LogLevel;
 use slosh_msgs::builtin_interfaces::Time;
@@ -30,7 +29,7 @@ impl LiveNode<'_> {
         let dt_cap = self.params.solver.dt_max;
         let limit = duration.map_or(until, |d| until.min(d + dt_cap));
         // The first pass at t = 0 takes no step: it only publishes the initial state (output 0).
-        let mut initial = self.next_output == 0 && self.sim.time() == 0.0;
+        let mut initial = self.outputs.times.at_start() && self.sim.time() == 0.0;
         let mut stepped = false;
         while (initial || self.sim.time() + dt_cap < limit) && !stop.load(Ordering::Relaxed) {
             if !std::mem::take(&mut initial) {
@@ -40,7 +39,7 @@ impl LiveNode<'_> {
                 stepped = true;
             }
             self.drain_reader()?;
-            if self.output_due() && !self.publish_outputs(base)? {
+            if !self.publish_outputs(base)? {
                 break;
             }
             if self.wall() - self.report.last_diag.wall > 1.0 / self.live.diagnostics_rate_hz {
@@ -78,8 +77,8 @@ impl LiveNode<'_> {
     /// whatever the step), then the input conventions' check on the apparent gravity. False: the solver
     /// failed (`error`).
     fn step(&mut self) -> bool {
-        let to = self.next_output as f64 / self.live.output_rate_hz;
-        if let Err(e) = self.sim.step_to(&self.intake.motion, to) {
+        let motion = &self.intake.motion;
+        if let Err(e) = self.outputs.step(self.sim.as_mut(), motion, f64::INFINITY) {
             self.error = Some(e.to_string());
             return false;
         }
@@ -98,83 +97,6 @@ impl LiveNode<'_> {
             None => {}
         }
         true
-    }
-
-    fn output_due(&self) -> bool {
-        self.sim.time() >= self.next_output as f64 / self.live.output_rate_hz - 1e-9
-    }
-
-    /// Observes the state and publishes it: wrench, probes and pressures, the bodies', iceoryx2's outputs,
-    /// `/clock` in lockstep, a particle cloud when one is due; records them. False: the observation failed
-    /// (`error`).
-    fn publish_outputs(&mut self, base: f64) -> anyhow::Result<bool> {
-        let cfg = self.cfg;
-        let t = self.sim.time();
-        let o = match self.sim.observe(&self.intake.motion) {
-            Ok(o) => o,
-            Err(e) => {
-                self.error = Some(e.to_string());
-                return Ok(false);
-            }
-        };
-        let stamp = Time::from_secs_f64(base + o.time);
-        let m = output_messages(&self.params, &cfg.config.frames.tank, stamp, &o);
-        if let Some(r) = self.recorder.as_mut() {
-            r.write_outputs(&self.ends.out_topics, stamp, &m)?;
-        }
-        let ends = &self.ends;
-        if let Some((pw, pp, ps)) = &ends.out.liquid {
-            publish(pw, m.wrench, "wrench")?;
-            publish(pp, m.probes, "probes")?;
-            publish(ps, m.pressures, "pressures")?;
-        }
-        for (b, (po, pw)) in m.bodies.into_iter().zip(&ends.out.bodies) {
-            publish(po, b.odom, "body odom")?;
-            publish(pw, b.wrench, "body wrench")?;
-        }
-        if let (Some(p), true) = (ends.iox_ports.as_ref(), cfg.config.iceoryx2.outputs) {
-            let mut so = crate::iox::outputs_of(base + o.time, &o);
-            so.steps = (self.sim.stats().steps - self.steps_at_output) as u32;
-            p.publish(&so)?;
-        }
-        self.steps_at_output = self.sim.stats().steps;
-        if let Some(pc) = &ends.out.clock {
-            publish(pc, Clock { clock: stamp }, "/clock")?;
-            self.last_clock = Some(stamp);
-        }
-        self.report.counters.published += 1;
-        let rate = self.live.particles_rate_hz;
-        if rate > 0.0 && t >= self.next_cloud as f64 / rate - 1e-9 {
-            self.publish_cloud(stamp, base + o.time)?;
-            self.next_cloud = (t * rate + 1e-9).floor() as u64 + 1;
-        }
-        self.next_output = (t * self.live.output_rate_hz + 1e-9).floor() as u64 + 1;
-        Ok(true)
-    }
-
-    /// The liquid as a particle cloud (recorded even when only iceoryx2 publishes), and the iceoryx2
-    /// particle frame.
-    fn publish_cloud(&mut self, stamp: Time, time: f64) -> anyhow::Result<()> {
-        let c = &self.cfg.config;
-        if self.ends.out.cloud.is_some() || self.recorder.is_some() {
-            let cloud = crate::ros::cloud::particle_cloud(
-                stamp,
-                &c.frames.tank,
-                &self.sim.fluid_positions(),
-                &self.sim.fluid_velocities(),
-                self.live.particles_decimation,
-            );
-            if let Some(r) = self.recorder.as_mut() {
-                r.write(&self.ends.cloud_topic, stamp, &cloud)?;
-            }
-            if let Some(pc) = &self.ends.out.cloud {
-                publish(pc, cloud, "particles")?;
-            }
-        }
-        if let (Some(p), true) = (self.ends.iox_ports.as_mut(), c.iceoryx2.particles) {
-            p.publish_particles(time, &self.sim.snapshot())?;
-        }
-        Ok(())
     }
 
     /// `follow_clock`: the ROS time from `/clock`; warns while motion comes but no `/clock`, or while

@@ -11,7 +11,7 @@
 //! 2. until a first sample is accepted, waits for motion and says why it has none (`LiveNode::wait_for_motion`);
 //!    in real-time mode, holds the last pose once the input has been silent for `motion_timeout_s`;
 //! 3. steps the solver up to what the input (and `/clock` when following it) allows, landing on each output
-//!    time and publishing there (`advance.rs`);
+//!    time and publishing there (`advance.rs`; the outputs' sinks: `outputs.rs`);
 //! 4. publishes diagnostics with the node's state: waiting, running, behind real time, holding, paused
 //!    (`report.rs`).
 //!
@@ -21,6 +21,7 @@
 mod advance;
 mod input;
 mod intake;
+mod outputs;
 mod report;
 mod services;
 mod start;
@@ -204,11 +205,10 @@ struct LiveNode<'c> {
     sim: Box<dyn sph::Solver>,
     intake: Intake,
     report: Report,
-    /// Outputs at k / rate (the steps land on them), the first the state at t = 0 before any step; clouds
-    /// likewise at their rate.
-    next_output: u64,
-    next_cloud: u64,
-    steps_at_output: u64,
+    /// Outputs at k / rate (the steps land on them), the first the state at t = 0 before any step.
+    outputs: crate::drive::Outputs,
+    /// Particle clouds' times (at an output time when one is due).
+    clouds: crate::drive::Grid,
     /// The ROS time of the newest `/clock` message (`follow_clock`).
     ros_time: Option<f64>,
     /// The stamp of the last `/clock` published (`lockstep`).

@@ -41,10 +41,8 @@ impl LiveNode<'_> {
             })?;
         if self.live != before {
             let t = self.sim.time();
-            self.next_output = (t * self.live.output_rate_hz + 1e-9).floor() as u64 + 1;
-            if self.live.particles_rate_hz > 0.0 {
-                self.next_cloud = (t * self.live.particles_rate_hz + 1e-9).floor() as u64 + 1;
-            }
+            self.outputs.times.set_rate(self.live.output_rate_hz, t);
+            self.clouds.set_rate(self.live.particles_rate_hz, t);
         }
         Ok(())
     }
@@ -54,8 +52,8 @@ impl LiveNode<'_> {
         self.sim = sph::build(self.params.clone())?;
         self.intake.motion = self.fresh_motion();
         self.intake.newest_stamp = None;
-        self.next_output = 0;
-        self.next_cloud = 0;
+        self.outputs.restart();
+        self.clouds.restart();
         self.intake.rebase = self.intake.t0.is_some();
         Ok("liquid reset to rest; the next motion sample is t = 0".to_string())
     }
