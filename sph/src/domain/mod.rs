@@ -117,6 +117,69 @@ impl<C: Comm> Comm for Timed<C> {
 
 pub(crate) static WORLD: OnceLock<Arc<dyn Comm>> = OnceLock::new();
 
+/// The processes a simulation spans: one, or this rank's part of a decomposition over several. What crosses
+/// ranks (sums, rank 0's values, which rank reads a place) is asked of it alike in both cases; with one
+/// process each answer is the local value.
+pub(crate) enum Processes {
+    One,
+    Many(Domain),
+}
+
+impl Processes {
+    /// The decomposition, when there is one (exchanging particles, gathering them).
+    pub(crate) fn domain(&self) -> Option<&Domain> {
+        match self {
+            Processes::One => None,
+            Processes::Many(d) => Some(d),
+        }
+    }
+
+    pub(crate) fn domain_mut(&mut self) -> Option<&mut Domain> {
+        match self {
+            Processes::One => None,
+            Processes::Many(d) => Some(d),
+        }
+    }
+
+    /// The same scheme-facing view as a trait object (None: one process).
+    pub(crate) fn ranks<const D: usize>(&mut self) -> Option<&mut dyn Ranks<D>> {
+        self.domain_mut().map(|d| d as &mut dyn Ranks<D>)
+    }
+
+    /// Element-wise reduction over ranks, result on every rank.
+    pub(crate) fn reduce(&self, v: &mut [f64], op: Op) {
+        if let Processes::Many(d) = self {
+            d.comm.reduce(v, op);
+        }
+    }
+
+    /// Rank 0's `local()` on every rank (only rank 0 evaluates it).
+    pub(crate) fn root_values<const N: usize>(&self, local: impl FnOnce() -> [f64; N]) -> [f64; N] {
+        match self {
+            Processes::One => local(),
+            Processes::Many(d) => {
+                let mut buf = if d.is_root() {
+                    local().to_vec()
+                } else {
+                    Vec::new()
+                };
+                d.comm.broadcast(&mut buf);
+                std::array::from_fn(|k| buf[k])
+            }
+        }
+    }
+
+    /// Whether this rank reads the place at x along the tank (its slab holds it).
+    pub(crate) fn owns<const D: usize>(&self, grid: &crate::neighbours::Grid<D>, x: f64) -> bool {
+        self.domain().is_none_or(|d| d.owns(grid, x))
+    }
+
+    /// Ranks the simulation runs on.
+    pub(crate) fn size(&self) -> usize {
+        self.domain().map_or(1, |d| d.comm.size())
+    }
+}
+
 /// Makes [`crate::build`] decompose every simulation over `comm`'s ranks (once per process, by the program
 /// that started MPI; a world of one rank changes nothing).
 pub fn install(comm: Arc<dyn Comm>) {

@@ -5,7 +5,7 @@
 use super::wcsph::Coefficients;
 use super::PassTotals;
 use crate::body::{Bodies, RigidBody};
-use crate::domain::{Domain, Op};
+use crate::domain::{Op, Processes};
 use crate::eos::Tait;
 use crate::error::SimError;
 use crate::kernel::Kernel;
@@ -68,8 +68,8 @@ pub struct State<const D: usize, K: Kernel> {
     pub(crate) scratch: SortScratch,
     /// A time the current step must not pass ([`crate::Simulation::step_to`]; ∞ otherwise).
     pub(crate) step_limit: f64,
-    /// This rank's part of a decomposition over several processes (MPI), if any.
-    pub(crate) dom: Option<Domain>,
+    /// The processes the simulation spans: one, or this rank's part of a decomposition (MPI).
+    pub(crate) processes: Processes,
     /// Floating bodies (their particles are among `bound`).
     pub(crate) bodies: Bodies,
 }
@@ -95,46 +95,26 @@ impl<const D: usize, K: Kernel> State<D, K> {
 
     /// The frame terms of the motion at t (across ranks: rank 0's motion, broadcast).
     pub(crate) fn frame(&self, motion: &dyn TankMotion, t: f64) -> FrameTerms {
-        let local = || {
+        // As the passes use them, in f32 (exact through the f64 of a broadcast).
+        let v: [f64; 9] = self.processes.root_values(|| {
             let s = motion.state(t);
-            let f = |v: nalgebra::Vector3<f64>| [v.x as f32, v.y as f32, v.z as f32];
-            FrameTerms {
-                g: f(s.apparent_gravity(self.params.gravity)),
-                w: f(s.angular_velocity),
-                dw: f(s.angular_acceleration),
-            }
-        };
-        let Some(dom) = &self.dom else {
-            return local();
-        };
-        let mut buf = Vec::new();
-        if dom.is_root() {
-            let f = local();
-            buf.extend(f.g.iter().chain(&f.w).chain(&f.dw).map(|&v| v as f64));
-        }
-        dom.comm.broadcast(&mut buf);
-        let v = |k: usize| std::array::from_fn(|d| buf[3 * k + d] as f32);
+            let g = s.apparent_gravity(self.params.gravity);
+            let terms = [g, s.angular_velocity, s.angular_acceleration];
+            std::array::from_fn(|k| f64::from(terms[k / 3][k % 3] as f32))
+        });
+        let f = |k: usize| std::array::from_fn(|d| v[3 * k + d] as f32);
         FrameTerms {
-            g: v(0),
-            w: v(1),
-            dw: v(2),
+            g: f(0),
+            w: f(1),
+            dw: f(2),
         }
     }
 
     /// When the motion ends, or the step must end ([`crate::Simulation::step_to`]) if sooner (across ranks:
     /// rank 0's).
     pub(crate) fn end_time(&self, motion: &dyn TankMotion) -> f64 {
-        match &self.dom {
-            None => motion.end_time().min(self.step_limit),
-            Some(dom) => {
-                let mut buf = Vec::new();
-                if dom.is_root() {
-                    buf.push(motion.end_time().min(self.step_limit));
-                }
-                dom.comm.broadcast(&mut buf);
-                buf[0]
-            }
-        }
+        self.processes
+            .root_values(|| [motion.end_time().min(self.step_limit)])[0]
     }
 
     /// Counts a finished step of `dt` from t: the time lands exactly on `end` when the step was cut to it
@@ -150,7 +130,7 @@ impl<const D: usize, K: Kernel> State<D, K> {
     /// Re-bins the liquid (across ranks: redistributes it) at time t; with `walls`, the halo walls'
     /// densities come along.
     pub(crate) fn rebin(&mut self, t: f64, walls: bool) -> Result<(), SimError> {
-        if self.dom.is_some() {
+        if self.processes.domain().is_some() {
             return self.redistribute(t, walls);
         }
         self.lost += self.fluid.sort(&self.grid, &mut self.scratch);
@@ -163,7 +143,7 @@ impl<const D: usize, K: Kernel> State<D, K> {
     /// Across ranks, where one process sorts its cells: particles move to their slab's rank, the halos
     /// (and with `walls`, the halo walls' densities) are rebuilt, the slabs rebalanced now and then.
     fn redistribute(&mut self, t: f64, walls: bool) -> Result<(), SimError> {
-        let Some(dom) = &mut self.dom else {
+        let Some(dom) = self.processes.domain_mut() else {
             return Ok(());
         };
         let rebalance = self
@@ -200,7 +180,7 @@ impl<const D: usize, K: Kernel> State<D, K> {
     /// partitioned step, [`RigidBody::accelerate_relaxed`]).
     pub(crate) fn accelerate_bodies(&mut self, frame: &FrameTerms, relaxed: bool) {
         let mut wrenches = self.bodies.sum_forces();
-        if let Some(dom) = &self.dom {
+        if self.processes.domain().is_some() {
             // Each rank summed its own liquid's part: the totals, the same on every rank, so every rank
             // moves the bodies alike.
             let mut v: Vec<f64> = wrenches
@@ -209,7 +189,7 @@ impl<const D: usize, K: Kernel> State<D, K> {
                 .chain(self.bodies.total_force)
                 .chain(self.bodies.total_moment)
                 .collect();
-            dom.comm.reduce(&mut v, Op::Sum);
+            self.processes.reduce(&mut v, Op::Sum);
             for (i, w) in wrenches.iter_mut().enumerate() {
                 w.0 = nalgebra::Vector3::from_fn(|k, _| v[6 * i + k]);
                 w.1 = nalgebra::Vector3::from_fn(|k, _| v[6 * i + 3 + k]);

@@ -87,7 +87,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let top = s.params.tank.height;
         // Across ranks, each probe and sensor is read by the rank whose slab holds it (its halo holds all
         // the liquid in reach), the others add zero.
-        let mine = |x: f64| s.dom.as_ref().is_none_or(|d| d.owns(grid, x));
+        let mine = |x: f64| s.processes.owns(grid, x);
         let mut probes: Vec<f64> = (s.params.probes.iter())
             .map(|p| {
                 if !mine(p.x) {
@@ -115,10 +115,10 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                 }
             })
             .collect();
-        if let Some(dom) = &s.dom {
+        if s.processes.domain().is_some() {
             let np = probes.len();
             let mut v: Vec<f64> = probes.iter().chain(&pressures).copied().collect();
-            dom.comm.reduce(&mut v, Op::Sum);
+            s.processes.reduce(&mut v, Op::Sum);
             probes.copy_from_slice(&v[..np]);
             pressures.copy_from_slice(&v[np..]);
         }
@@ -187,7 +187,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
     }
 
     pub fn counts(&self) -> Counts {
-        match &self.state.dom {
+        match self.state.processes.domain() {
             None => Counts {
                 fluid: self.state.fluid.len(),
                 boundary: self.state.bound.len(),
@@ -205,12 +205,12 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     /// Ranks the simulation runs on.
     pub fn ranks(&self) -> usize {
-        self.state.dom.as_ref().map_or(1, |d| d.comm.size())
+        self.state.processes.size()
     }
 
     /// Times the subdomains were moved to even out the particle counts.
     pub fn rebalances(&self) -> u64 {
-        self.state.dom.as_ref().map_or(0, |d| d.rebalances)
+        self.state.processes.domain().map_or(0, |d| d.rebalances)
     }
 
     pub fn params(&self) -> &SimParams {
@@ -255,9 +255,7 @@ pub(super) fn flooded_volumes<const D: usize, K: Kernel>(s: &State<D, K>) -> Vec
             n as f64
         })
         .collect();
-    if let Some(dom) = &s.dom {
-        dom.comm.reduce(&mut v, Op::Sum);
-    }
+    s.processes.reduce(&mut v, Op::Sum);
     v.iter().map(|n| n * cell).collect()
 }
 

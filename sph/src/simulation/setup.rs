@@ -4,7 +4,7 @@
 use super::{flooded_volumes, Simulation};
 use crate::body::{piston, shell, RigidBody};
 use crate::boundary::dynamic;
-use crate::domain::{Comm, Domain};
+use crate::domain::{Comm, Domain, Processes};
 use crate::eos::Tait;
 use crate::error::SimError;
 use crate::kernel::Kernel;
@@ -150,8 +150,8 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             };
             rest_density(&kernel, &fluid, &bound, m_fluid as f32, m_bound, near_body) as f32
         };
-        let dom = match comm.filter(|c| c.size() > 1) {
-            None => None,
+        let processes = match comm.filter(|c| c.size() > 1) {
+            None => Processes::One,
             Some(c) => {
                 // Mirror ghosts are rebuilt from where particles are mid-step, which may be a column
                 // beyond where they were sorted: one more halo column brings their sources.
@@ -159,7 +159,9 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
                     BoundaryMethod::Mirror => crate::neighbours::REACH + 1,
                     BoundaryMethod::Dynamic => crate::neighbours::REACH,
                 };
-                Some(Domain::split(c, &grid, &mut fluid, halo).map_err(SimError::Decomposition)?)
+                Processes::Many(
+                    Domain::split(c, &grid, &mut fluid, halo).map_err(SimError::Decomposition)?,
+                )
             }
         };
         fluid.sort(&grid, &mut scratch);
@@ -223,7 +225,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             rates_current: false,
             scratch,
             step_limit: f64::INFINITY,
-            dom,
+            processes,
             bodies,
         };
         let scheme: Box<dyn PressureScheme<D, K>> = match state.params.solver.scheme {

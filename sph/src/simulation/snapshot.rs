@@ -23,7 +23,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
 
     fn fluid_field(&self, at: impl Fn(&Fluid<D>, usize) -> [f64; 3]) -> Vec<[f64; 3]> {
         let f = &self.state.fluid;
-        let Some(dom) = &self.state.dom else {
+        let Some(dom) = self.state.processes.domain() else {
             return (0..f.len()).map(|i| at(f, i)).collect();
         };
         let mut local = Vec::new();
@@ -70,7 +70,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             s.id.push(f.id[i]);
         }
         s.fluid = s.id.len();
-        if let Some(dom) = &self.state.dom {
+        if let Some(dom) = self.state.processes.domain() {
             return self.gather_snapshot(dom, s);
         }
         for j in 0..nb {

@@ -1116,7 +1116,7 @@ pub fn step<const D: usize, K: Kernel>(
     let spec = &s.params.solver.dfsph;
     let dp = s.params.particle_spacing;
     let (kernel, grid, bound, fluid) = (&s.kernel, &s.grid, &s.bound, &mut s.fluid);
-    let mut ranks = s.dom.as_mut().map(|d| d as &mut dyn Ranks<D>);
+    let mut ranks = s.processes.ranks::<D>();
     let n = fluid.len();
     work.resize(n);
     let p = Ctx {

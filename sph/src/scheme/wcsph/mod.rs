@@ -132,7 +132,7 @@ impl<const D: usize> Wcsph<D> {
         let walls = s.params.solver.boundary.method == BoundaryMethod::Dynamic;
         if sort {
             s.rebin(t, walls)?;
-        } else if let Some(dom) = &mut s.dom {
+        } else if let Some(dom) = s.processes.domain_mut() {
             // Across ranks, in the middle of a step: the halo copies are brought up to date in place.
             dom.refresh(&s.grid, &mut s.fluid, walls.then_some(&mut s.bound));
         }
@@ -159,9 +159,7 @@ impl<const D: usize> Wcsph<D> {
             &s.bound,
             &mut self.work,
         );
-        if let Some(dom) = &s.dom {
-            s.last.reduce_with(|v| dom.comm.reduce(v, Op::Sum));
-        }
+        s.last.reduce_with(|v| s.processes.reduce(v, Op::Sum));
         if walls {
             rates::wall_density_rates(
                 &s.kernel,
@@ -169,7 +167,7 @@ impl<const D: usize> Wcsph<D> {
                 &s.grid,
                 &s.fluid,
                 &mut s.bound,
-                s.dom.as_ref().map(|d| d.slabs.columns(d.comm.rank())),
+                s.processes.domain().map(|d| d.slabs.columns(d.comm.rank())),
             );
         }
         if !s.bodies.is_empty() {
@@ -198,10 +196,8 @@ fn time_step<const D: usize, K: Kernel>(s: &State<D, K>) -> Result<f64, SimError
     let h = s.coef.h as f64;
     let rmax = s.fluid.rho32.iter().fold(s.coef.rho0, |m, &r| m.max(r));
     let mut max = [rmax as f64, s.last.max_acc as f64, s.last.max_mu as f64];
-    if let Some(dom) = &s.dom {
-        // The maxima over all ranks (not the least of each rank's step: c and μ add up).
-        dom.comm.reduce(&mut max, Op::Max);
-    }
+    // The maxima over all ranks (not the least of each rank's step: c and μ add up).
+    s.processes.reduce(&mut max, Op::Max);
     let [rmax, max_acc, max_mu] = max;
     let cmax = s.eos.sound_speed(rmax as f32) as f64;
     let dt_f = if max_acc > 0.0 {
