@@ -5,9 +5,10 @@
 //! their motion (a configured law, a bag, the live input), their pacing (as fast as possible, at a rate,
 //! as the input comes) and their sinks.
 
-use crate::messages::output_messages;
 use crate::sinks::{FrameSink, Output, Sink, SinkError, TimeBase};
+use slosh_msgs::builtin_interfaces::Time;
 use sph::motion::TankMotion;
+use sph::observe::Observation;
 use sph::params::SimParams;
 use sph::{SimError, Solver};
 
@@ -67,23 +68,59 @@ pub enum DriveError {
     Sink(#[from] SinkError),
 }
 
-/// A drive loop's outputs: their times, and what their messages name (the probes and sensors of the case,
-/// the tank's frame).
-pub struct Outputs {
-    pub times: Grid,
+/// How observed states reach the sinks: what their messages name (the probes and sensors of the case, the
+/// tank's frame) and the solver's step count at the last one.
+pub struct Delivery {
     params: SimParams,
     tank_frame: String,
-    /// The solver's step count at the last output.
     steps_then: u64,
+}
+
+impl Delivery {
+    pub fn new(params: &SimParams, tank_frame: &str) -> Self {
+        Self {
+            params: params.clone(),
+            tank_frame: tank_frame.to_string(),
+            steps_then: 0,
+        }
+    }
+
+    /// Hands `observation`, reached under `motion` and stamped `(stamp, seconds)`, to every sink in order;
+    /// `steps`: the solver's step count now (each output carries those since the previous one).
+    pub fn hand_out(
+        &mut self,
+        observation: &Observation,
+        motion: &dyn TankMotion,
+        stamp: (Time, f64),
+        steps: u64,
+        sinks: &mut [&mut dyn Sink],
+    ) -> Result<(), SinkError> {
+        let names = (&self.params, self.tank_frame.as_str());
+        let out = Output::new(observation, stamp, motion, steps - self.steps_then, names);
+        for s in sinks.iter_mut() {
+            s.observed(&out)?;
+        }
+        self.steps_then = steps;
+        Ok(())
+    }
+
+    /// Steps counted from 0 again (a fresh solver).
+    pub fn restart(&mut self) {
+        self.steps_then = 0;
+    }
+}
+
+/// A drive loop's outputs: their times, and how they reach the sinks.
+pub struct Outputs {
+    pub times: Grid,
+    delivery: Delivery,
 }
 
 impl Outputs {
     pub fn new(rate: f64, params: &SimParams, tank_frame: &str) -> Self {
         Self {
             times: Grid::new(rate),
-            params: params.clone(),
-            tank_frame: tank_frame.to_string(),
-            steps_then: 0,
+            delivery: Delivery::new(params, tank_frame),
         }
     }
 
@@ -112,21 +149,10 @@ impl Outputs {
             return Ok(false);
         }
         let observation = sim.observe(motion)?;
-        let stamp = base.stamp(observation.time);
-        let messages = output_messages(&self.params, &self.tank_frame, stamp, &observation);
+        let stamp = (base.stamp(observation.time), base.seconds(observation.time));
         let steps = sim.stats().steps;
-        let out = Output {
-            observation: &observation,
-            messages: &messages,
-            stamp,
-            seconds: base.seconds(observation.time),
-            motion,
-            steps: steps - self.steps_then,
-        };
-        for s in sinks.iter_mut() {
-            s.observed(&out)?;
-        }
-        self.steps_then = steps;
+        self.delivery
+            .hand_out(&observation, motion, stamp, steps, sinks)?;
         self.times.pass(t);
         Ok(true)
     }
@@ -134,7 +160,7 @@ impl Outputs {
     /// From t = 0 again, with a fresh solver (a reset).
     pub fn restart(&mut self) {
         self.times.restart();
-        self.steps_then = 0;
+        self.delivery.restart();
     }
 }
 
@@ -161,7 +187,6 @@ pub fn deliver_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use slosh_msgs::builtin_interfaces::Time;
 
     #[test]
     fn a_grid_is_due_at_its_times_and_passes_to_the_next() {

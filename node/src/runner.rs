@@ -89,7 +89,7 @@ pub fn run(
             r,
             &frame,
             out.stamp,
-            out.messages,
+            out.messages(),
             &out.motion.state(out.observation.time),
         )
     };
@@ -206,8 +206,7 @@ pub fn drive(
         recorder: r,
         record: &mut **f,
     });
-    let mut sinks: Vec<&mut dyn Sink> = vec![&mut csv];
-    sinks.extend(recording.as_mut().map(|r| r as &mut dyn Sink));
+    let mut sinks: [&mut dyn Sink; 2] = [&mut csv, &mut recording];
     let mut outputs = Outputs::new(cfg.config.output_rate_hz, &params, &cfg.config.frames.tank);
     let result = run_loop(
         sim.as_mut(),
@@ -224,7 +223,6 @@ pub fn drive(
         &bar,
     );
     let wall = start.elapsed().as_secs_f64();
-    drop(sinks);
     bar.finish_and_clear();
     // The CSVs are flushed and the bag finished on every path, also when the solver stopped; the first
     // failure is the one reported (a bag that failed to write usually fails to finish too).

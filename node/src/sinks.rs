@@ -4,13 +4,15 @@
 //! [`FrameSink`] (ParaView files, the node's point clouds). The loop that produces them is
 //! [`crate::drive`], which stamps them on its [`TimeBase`].
 
-use crate::messages::OutputMessages;
+use crate::messages::{output_messages, OutputMessages};
 use crate::output::CsvOutputs;
 use crate::record::{RecordError, Recorder};
 use slosh_msgs::builtin_interfaces::Time;
 use sph::motion::TankMotion;
 use sph::observe::Observation;
+use sph::params::SimParams;
 use sph::Solver;
+use std::cell::OnceCell;
 
 /// Why a sink could not take an output.
 #[derive(Debug, thiserror::Error)]
@@ -59,8 +61,6 @@ impl TimeBase {
 /// One output time's state, as every sink gets it.
 pub struct Output<'a> {
     pub observation: &'a Observation,
-    /// The observation as messages (wrench, probes, pressures, the bodies'), stamped.
-    pub messages: &'a OutputMessages,
     /// The state's time on the driver's time base, and the same in seconds.
     pub stamp: Time,
     pub seconds: f64,
@@ -68,6 +68,40 @@ pub struct Output<'a> {
     pub motion: &'a dyn TankMotion,
     /// Solver steps since the previous output.
     pub steps: u64,
+    /// What the messages name: the case (its probes and sensors) and the tank's frame.
+    names: (&'a SimParams, &'a str),
+    /// The messages, built by the first sink that asks.
+    messages: OnceCell<OutputMessages>,
+}
+
+impl<'a> Output<'a> {
+    /// The state `observation`, stamped `stamp` (`seconds` in seconds), reached under `motion` in `steps`
+    /// solver steps since the previous output; its messages name the sensors of `params` and `tank_frame`.
+    pub fn new(
+        observation: &'a Observation,
+        (stamp, seconds): (Time, f64),
+        motion: &'a dyn TankMotion,
+        steps: u64,
+        (params, tank_frame): (&'a SimParams, &'a str),
+    ) -> Self {
+        Self {
+            observation,
+            stamp,
+            seconds,
+            motion,
+            steps,
+            names: (params, tank_frame),
+            messages: OnceCell::new(),
+        }
+    }
+
+    /// The observation as messages (wrench, probes, pressures, the bodies'), stamped: built once, when
+    /// a sink first asks (a driver whose sinks all take the observation builds none).
+    pub fn messages(&self) -> &OutputMessages {
+        self.messages.get_or_init(|| {
+            output_messages(self.names.0, self.names.1, self.stamp, self.observation)
+        })
+    }
 }
 
 /// A destination of outputs.
@@ -91,6 +125,28 @@ pub trait FrameSink {
         motion: &dyn TankMotion,
         base: TimeBase,
     ) -> Result<(), SinkError>;
+}
+
+/// A sink lent for one output.
+impl<S: Sink + ?Sized> Sink for &mut S {
+    fn observed(&mut self, out: &Output) -> Result<(), SinkError> {
+        (**self).observed(out)
+    }
+
+    fn flush(&mut self) -> Result<(), SinkError> {
+        (**self).flush()
+    }
+}
+
+/// A sink that may be absent (a file or transport not asked for): takes nothing when it is.
+impl<S: Sink> Sink for Option<S> {
+    fn observed(&mut self, out: &Output) -> Result<(), SinkError> {
+        self.as_mut().map_or(Ok(()), |s| s.observed(out))
+    }
+
+    fn flush(&mut self) -> Result<(), SinkError> {
+        self.as_mut().map_or(Ok(()), |s| s.flush())
+    }
 }
 
 impl Sink for CsvOutputs {

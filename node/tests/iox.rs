@@ -162,7 +162,11 @@ fn coupling_follows_an_offline_run_of_the_same_motion_and_refuses_bad_samples() 
     let offline = csv(&dir.join("offline/probes.csv"));
     let offline_w = csv(&dir.join("offline/wrench.csv"));
 
-    let srv = server(&case, &["--max-steps", "20"]);
+    let couple_dir = dir.join("couple");
+    let srv = server(
+        &case,
+        &["--max-steps", "20", "--out", couple_dir.to_str().unwrap()],
+    );
     let client = CouplingClient::connect("t", Duration::from_secs(30)).unwrap();
     let cfg = slosh_node::config::load(case.to_str().unwrap(), &[]).unwrap();
     let motion = slosh_node::motion_source::build(&cfg).unwrap();
@@ -207,6 +211,21 @@ fn coupling_follows_an_offline_run_of_the_same_motion_and_refuses_bad_samples() 
     let summary = finish(srv);
     assert_eq!(summary["steps_answered"], 21);
     assert_eq!(summary["samples_rejected"], 3);
+    // The CSV files hold what was answered, a row per answer, time from the first sample.
+    let rows = csv(&couple_dir.join("probes.csv"));
+    let wrench = csv(&couple_dir.join("wrench.csv"));
+    assert_eq!((rows.len(), wrench.len()), (21, 21));
+    for (k, out) in got.iter().enumerate() {
+        assert!((rows[k][0] - (out.time - t0)).abs() < 1e-6, "{:?}", rows[k]);
+        for (i, p) in out.probes().iter().enumerate() {
+            assert!(
+                (rows[k][1 + i] - p).abs() <= 1e-6 * p.abs(),
+                "{:?}",
+                rows[k]
+            );
+        }
+        assert!((wrench[k][1] - out.force[0]).abs() <= 1e-6 * out.force[0].abs().max(1e-3));
+    }
     // Same liquid as the offline run: the tank follows the exact motion there and the Hermite path through
     // the 20 Hz states here.
     let mut worst = 0.0f64;
@@ -227,6 +246,75 @@ fn coupling_follows_an_offline_run_of_the_same_motion_and_refuses_bad_samples() 
     assert!(worst < 0.005, "probes differ by {worst} m");
     assert!(rel < 0.1, "fx differs by {:.1} % rms", 100.0 * rel);
     drop(client);
+    iox.assert_clean();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_dry_server_answers_with_the_first_state_at_each_sample_time_on_every_output() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let iox = Iox::new("dry");
+    let dir = tmp("iox-dry");
+    let case = dir.join("case.yaml");
+    std::fs::write(&case, CASE).unwrap();
+    let out_dir = dir.join("couple");
+    let srv = server(
+        &case,
+        &[
+            "--dry",
+            "--max-steps",
+            "5",
+            "--particles",
+            "20",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+    );
+    let viewer = node("test_dry_viewer").unwrap();
+    let published = outputs_service(&viewer, "t")
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap();
+    let client = CouplingClient::connect("t", Duration::from_secs(30)).unwrap();
+    let cfg = slosh_node::config::load(case.to_str().unwrap(), &[]).unwrap();
+    let motion = slosh_node::motion_source::build(&cfg).unwrap();
+    let t0 = 7.0;
+    let mut got = vec![];
+    for k in 0..=5 {
+        let t = k as f64 * 0.1;
+        let out = client.step(&sample_of(t0 + t, &motion.state(t))).unwrap();
+        assert_eq!(out.status, STATUS_OK, "{}", out.message());
+        // Nothing simulated: each answer is the first state, at its own sample's time.
+        assert_eq!((out.time, out.steps), (t0 + t, 0));
+        if let Some(first) = got.first() {
+            let first: &StepOutputs = first;
+            assert_eq!((out.force, out.probes()), (first.force, first.probes()));
+        }
+        got.push(out);
+    }
+    let summary = finish(srv);
+    assert_eq!(
+        (&summary["steps_answered"], &summary["solver_steps"]),
+        (&6.into(), &0.into())
+    );
+    // A frame for each sample (20 Hz of sample time, samples 0.1 s apart).
+    assert_eq!(summary["particle_frames"], 6);
+    // The outputs service carried the answers, in order.
+    let mut seen = vec![];
+    while let Some(o) = published.receive().unwrap() {
+        seen.push((o.time, o.steps, o.force));
+    }
+    let want: Vec<_> = got.iter().map(|o| (o.time, o.steps, o.force)).collect();
+    assert_eq!(seen, want);
+    // And the CSV files: a row per answer, time from the first sample.
+    let rows = csv(&out_dir.join("probes.csv"));
+    assert_eq!(rows.len(), 6);
+    for (k, row) in rows.iter().enumerate() {
+        assert!((row[0] - 0.1 * k as f64).abs() < 1e-6, "{row:?}");
+        assert!((row[1] - got[0].probes()[0]).abs() <= 1e-6 * got[0].probes()[0]);
+    }
+    drop((published, viewer, client));
     iox.assert_clean();
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -13,10 +13,16 @@
 
 use super::*;
 use crate::config::Loaded;
+use crate::drive::{deliver_frame, Delivery, Grid};
 use crate::output::CsvOutputs;
+use crate::sinks::{Output, Sink, SinkError, TimeBase};
 use nalgebra::{UnitQuaternion, Vector3};
+use slosh_msgs::builtin_interfaces::Time;
 use sph::motion::{CoupledMotion, TankMotion};
+use sph::observe::snapshot::Snapshot;
 use sph::observe::Observation;
+use sph::params::SimParams;
+use sph::{Counts, SimError, Solver, Stats};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -83,7 +89,10 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
         max_speed: cfg.config.input.max_speed,
         max_rotation_rate: cfg.config.input.max_rotation_rate,
     };
-    let mut sim = sph::build(params.clone())?;
+    let mut sim: Box<dyn Solver> = match opts.dry {
+        false => sph::build(params.clone())?,
+        true => Box::new(Frozen::new(sph::build(params.clone())?)),
+    };
     let mut csv = match &opts.out {
         Some(d) => {
             let c = CsvOutputs::create(d, &params, false)?;
@@ -124,10 +133,12 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
     let stop = crate::signals::shutdown_flag().map_err(std::io::Error::other)?;
     ready();
 
+    // Every answered sample is an output: to the client first (its reply), then to the outputs service
+    // and the CSV files; particle frames on their own grid of sample time.
+    let mut delivery = Delivery::new(&params, &cfg.config.frames.tank);
+    let mut frames = Grid::new(opts.particles_hz);
     let mut served = Served::default();
     let mut motion: Option<(f64, CoupledMotion)> = None;
-    let mut initial: Option<StepOutputs> = None;
-    let mut next_frame = 0u64;
     let mut last_cleanup = Instant::now();
     let result: anyhow::Result<()> = 'serve: loop {
         if stop.load(std::sync::atomic::Ordering::Relaxed)
@@ -153,55 +164,52 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
                 Err(e) => break 'serve Err(anyhow::anyhow!("receiving a request: {e}")),
             };
             let s: MotionSample = *req.payload();
-            let (answer, failure) = step(
-                sim.as_mut(),
-                &mut motion,
-                &mut initial,
-                &s,
-                &mount,
-                &limits,
-                opts.dry,
-            );
-            if answer.status == STATUS_REJECTED {
-                served.samples_rejected += 1;
-            } else {
-                served.steps_answered += 1;
-                served.solver_steps = sim.stats().steps;
-                served.last_time = Some(s.time);
-            }
-            // A client that has gone does not get its answer: nothing else to do.
-            let _ = req.send_copy(answer);
-            let _ = notifier.notify();
-            if answer.status == STATUS_OK {
-                if let Err(e) = ports.publish(&answer) {
-                    break 'serve Err(e);
-                }
-                if let (Some(c), Some((t0, _))) = (csv.as_mut(), motion.as_ref()) {
-                    let mut o = Observation {
-                        time: s.time - t0,
-                        probes: answer.probes().to_vec(),
-                        pressures: answer.pressures().to_vec(),
+            let observation = match step(sim.as_mut(), &mut motion, &s, &mount, &limits) {
+                Ok(o) => o,
+                Err(why) => {
+                    let (status, text, failure) = match why {
+                        Unanswered::Rejected(text) => {
+                            served.samples_rejected += 1;
+                            (STATUS_REJECTED, text, None)
+                        }
+                        Unanswered::Failed(e) => (STATUS_FAILED, e.to_string(), Some(e)),
+                    };
+                    let mut answer = StepOutputs {
+                        time: s.time,
+                        status,
                         ..Default::default()
                     };
-                    o.wrench.force = answer.force;
-                    o.wrench.moment = answer.moment;
-                    if let Err(e) = c.write(&o) {
-                        break 'serve Err(e.into());
+                    answer.set_message(&text);
+                    // A client that has gone does not get its answer: nothing else to do.
+                    let _ = req.send_copy(answer);
+                    let _ = notifier.notify();
+                    match failure {
+                        Some(e) => break 'serve Err(e),
+                        None => continue,
                     }
                 }
-                if let (true, Some((t0, _))) = (opts.particles_hz > 0.0, motion.as_ref()) {
-                    if s.time - t0 >= next_frame as f64 / opts.particles_hz - 1e-9 {
-                        if let Err(e) = ports.publish_particles(s.time, &sim.snapshot()) {
-                            break 'serve Err(e);
-                        }
-                        served.particle_frames = ports.frames;
-                        next_frame = ((s.time - t0) * opts.particles_hz + 1e-9).floor() as u64 + 1;
-                    }
-                }
+            };
+            let (t0, m) = motion
+                .as_ref()
+                .expect("a state is observed only once started");
+            let mut reply = Reply {
+                request: &req,
+                notifier: &notifier,
+            };
+            let sinks: &mut [&mut dyn Sink] = &mut [&mut reply, &mut ports, &mut csv];
+            let stamp = (Time::from_secs_f64(s.time), s.time);
+            let steps = sim.stats().steps;
+            if let Err(e) = delivery.hand_out(&observation, m, stamp, steps, sinks) {
+                break 'serve Err(e.into());
             }
-            if let Some(e) = failure {
-                break 'serve Err(e);
+            served.steps_answered += 1;
+            served.solver_steps = steps;
+            served.last_time = Some(s.time);
+            let base = TimeBase::Seconds(*t0);
+            if let Err(e) = deliver_frame(&mut frames, sim.as_ref(), m, base, &mut [&mut ports]) {
+                break 'serve Err(e.into());
             }
+            served.particle_frames = ports.frames;
         }
     };
     if let Some(c) = csv {
@@ -210,30 +218,48 @@ pub fn serve(cfg: &Loaded, opts: &CoupleOptions, ready: impl FnOnce()) -> anyhow
     result.map(|()| served)
 }
 
-/// Answers one sample: the outputs, and the error that must stop the server (solver failure).
+/// The client's reply, as the first sink of an answered sample: the outputs at the sample's time.
+struct Reply<'a> {
+    request: &'a iceoryx2::active_request::ActiveRequest<
+        ipc::Service,
+        MotionSample,
+        (),
+        StepOutputs,
+        (),
+    >,
+    notifier: &'a iceoryx2::port::notifier::Notifier<ipc::Service>,
+}
+
+impl Sink for Reply<'_> {
+    fn observed(&mut self, out: &Output) -> Result<(), SinkError> {
+        let mut answer = outputs_of(out.seconds, out.observation);
+        answer.steps = out.steps as u32;
+        // A client that has gone does not get its answer: nothing else to do.
+        let _ = self.request.send_copy(answer);
+        let _ = self.notifier.notify();
+        Ok(())
+    }
+}
+
+/// Why a sample has no state to answer with.
+enum Unanswered {
+    /// Refused (the field named, and why): answered so; nothing was simulated.
+    Rejected(String),
+    /// The solver stopped: answered so, and the server stops with the error.
+    Failed(anyhow::Error),
+}
+
+/// Takes one sample: the state at its time (the simulation's clock starts at the first sample), or why
+/// there is none.
 fn step(
-    sim: &mut dyn sph::Solver,
+    sim: &mut dyn Solver,
     motion: &mut Option<(f64, CoupledMotion)>,
-    initial: &mut Option<StepOutputs>,
     s: &MotionSample,
     mount: &Mount,
     limits: &crate::input::live_motion::Limits,
-    dry: bool,
-) -> (StepOutputs, Option<anyhow::Error>) {
-    let reject = |msg: String| {
-        let mut o = StepOutputs {
-            time: s.time,
-            status: STATUS_REJECTED,
-            ..Default::default()
-        };
-        o.set_message(&msg);
-        (o, None)
-    };
-    if let Err(e) = check(s) {
-        return reject(e);
-    }
+) -> Result<Observation, Unanswered> {
+    check(s).map_err(Unanswered::Rejected)?;
     let state = tank_state(s, mount);
-    let steps_before = sim.stats().steps;
     let t_sim = match motion {
         None => {
             *motion = Some((s.time, CoupledMotion::new(0.0, state)));
@@ -242,52 +268,103 @@ fn step(
         Some((t0, m)) => {
             let t = s.time - *t0;
             if t <= m.newest() {
-                return reject(format!(
+                return Err(Unanswered::Rejected(format!(
                     "time: {} s is not after the last sample's {} s",
                     s.time,
                     m.newest() + *t0
-                ));
+                )));
             }
             // The node's check of its iceoryx2 input.
             let last = m.state(m.newest());
-            if let Err(e) =
-                crate::input::live_state::check_jump(limits, t - m.newest(), &last, &state)
-            {
-                return reject(e.to_string());
-            }
+            crate::input::live_state::check_jump(limits, t - m.newest(), &last, &state)
+                .map_err(|e| Unanswered::Rejected(e.to_string()))?;
             m.push(t, state);
             t
         }
     };
     let (_, m) = motion.as_ref().expect("set above");
-    let observed = if dry {
-        match initial {
-            Some(o) => Ok(*o),
-            None => sim.observe(m).map(|o| outputs_of(s.time, &o)),
+    sim.advance_to(m as &dyn TankMotion, t_sim)
+        .and_then(|()| sim.observe(m))
+        .map_err(|e| {
+            Unanswered::Failed(anyhow::anyhow!(
+                "solver stopped at t = {:.4} s: {e}",
+                sim.time()
+            ))
+        })
+}
+
+/// `--dry`: the simulation held in its initial state. Advancing moves only its clock (no solver steps),
+/// and every observation is the first one, at the clock's time.
+struct Frozen {
+    sim: Box<dyn Solver>,
+    time: f64,
+    first: Option<Observation>,
+}
+
+impl Frozen {
+    fn new(sim: Box<dyn Solver>) -> Self {
+        Self {
+            sim,
+            time: 0.0,
+            first: None,
         }
-    } else {
-        sim.advance_to(m as &dyn TankMotion, t_sim)
-            .and_then(|()| sim.observe(m))
-            .map(|o| outputs_of(s.time, &o))
-    };
-    match observed {
-        Ok(mut o) => {
-            if initial.is_none() {
-                *initial = Some(o);
-            }
-            o.time = s.time;
-            o.steps = (sim.stats().steps - steps_before) as u32;
-            (o, None)
-        }
-        Err(e) => {
-            let mut o = StepOutputs {
-                time: s.time,
-                status: STATUS_FAILED,
-                ..Default::default()
-            };
-            let text = format!("solver stopped at t = {:.4} s: {e}", sim.time());
-            o.set_message(&text);
-            (o, Some(anyhow::anyhow!(text)))
-        }
+    }
+}
+
+impl Solver for Frozen {
+    fn step(&mut self, _: &dyn TankMotion) -> Result<f64, SimError> {
+        Ok(0.0)
+    }
+    fn step_to(&mut self, _: &dyn TankMotion, limit: f64) -> Result<f64, SimError> {
+        let dt = (limit - self.time).max(0.0);
+        self.time += dt;
+        Ok(dt)
+    }
+    fn advance_to(&mut self, _: &dyn TankMotion, t_end: f64) -> Result<(), SimError> {
+        self.time = self.time.max(t_end);
+        Ok(())
+    }
+    fn observe(&mut self, motion: &dyn TankMotion) -> Result<Observation, SimError> {
+        let first = match &self.first {
+            Some(o) => o,
+            None => self.first.insert(self.sim.observe(motion)?),
+        };
+        Ok(Observation {
+            time: self.time,
+            ..first.clone()
+        })
+    }
+    fn time(&self) -> f64 {
+        self.time
+    }
+    fn stats(&self) -> Stats {
+        self.sim.stats()
+    }
+    fn counts(&self) -> Counts {
+        self.sim.counts()
+    }
+    fn params(&self) -> &SimParams {
+        self.sim.params()
+    }
+    fn liquid_mass(&self) -> f64 {
+        self.sim.liquid_mass()
+    }
+    fn fluid_positions(&self) -> Vec<[f64; 3]> {
+        self.sim.fluid_positions()
+    }
+    fn fluid_velocities(&self) -> Vec<[f64; 3]> {
+        self.sim.fluid_velocities()
+    }
+    fn set_fluid_velocity(&mut self, f: &dyn Fn([f64; 3]) -> [f64; 3]) {
+        self.sim.set_fluid_velocity(f)
+    }
+    fn snapshot(&self) -> Snapshot {
+        self.sim.snapshot()
+    }
+    fn ranks(&self) -> usize {
+        self.sim.ranks()
+    }
+    fn rebalances(&self) -> u64 {
+        self.sim.rebalances()
     }
 }

@@ -133,7 +133,7 @@ pub fn replay(
             )?;
             next += 1;
         }
-        r.write_outputs(&topics, out.stamp, out.messages)
+        r.write_outputs(&topics, out.stamp, out.messages())
     };
     let run = RunOptions {
         duration: Some(opts.duration.unwrap_or(span)),

@@ -23,14 +23,14 @@ impl Sink for Recorded<'_> {
     fn observed(&mut self, out: &Output) -> Result<(), SinkError> {
         Ok(self
             .recorder
-            .write_outputs(self.topics, out.stamp, out.messages)?)
+            .write_outputs(self.topics, out.stamp, out.messages())?)
     }
 }
 
 /// The outputs over DDS: the liquid's (unless iceoryx2 alone carries them) and each floating body's.
 impl Sink for &Publishers {
     fn observed(&mut self, out: &Output) -> Result<(), SinkError> {
-        let m = out.messages;
+        let m = out.messages();
         if let Some((pw, pp, ps)) = &self.liquid {
             publish(pw, m.wrench.clone(), "wrench")?;
             publish(pp, m.probes.clone(), "probes")?;
@@ -116,12 +116,8 @@ impl LiveNode<'_> {
             publisher,
             last: &mut self.last_clock,
         });
-        let iox = ends.iox_ports.as_mut().filter(|_| c.iceoryx2.outputs);
-        let mut sinks: Vec<&mut dyn Sink> = Vec::with_capacity(4);
-        sinks.extend(recorded.as_mut().map(|s| s as &mut dyn Sink));
-        sinks.push(&mut dds);
-        sinks.extend(iox.map(|s| s as &mut dyn Sink));
-        sinks.extend(lockstep.as_mut().map(|s| s as &mut dyn Sink));
+        let mut iox = ends.iox_ports.as_mut().filter(|_| c.iceoryx2.outputs);
+        let mut sinks: [&mut dyn Sink; 4] = [&mut recorded, &mut dds, &mut iox, &mut lockstep];
         let motion = &self.intake.motion;
         match self
             .outputs
@@ -134,7 +130,6 @@ impl LiveNode<'_> {
             }
             Err(crate::drive::DriveError::Sink(e)) => return Err(e.into()),
         }
-        drop(sinks);
         self.report.counters.published += 1;
         if !self.clouds.due(self.sim.time()) {
             return Ok(true);
