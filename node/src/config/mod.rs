@@ -12,7 +12,10 @@ pub use features::{
 use serde::Deserialize;
 use serde_json::{Map, Value};
 use sph::motion::{JonswapDof, RegularDof};
-use sph::params::{FillSpec, FluidSpec, ProbeSpec, SensorSpec, SimParams, SolverSpec, TankSpec};
+use sph::params::{
+    BodySpec, FillSpec, FluidSpec, ProbeSpec, RegionSpec, SensorSpec, SimParams, SolverSpec,
+    TankSpec,
+};
 use std::path::{Path, PathBuf};
 
 /// The cases shipped in `launch-configs/`, built into the binary so `slosh run NAME` and `slosh bench` work
@@ -94,115 +97,6 @@ pub enum ConfigError {
 }
 
 const DOF_NAMES: &str = "x, y, z, roll, pitch, yaw";
-
-/// An opening in a floating body's walls or an internal wall (see [`sph::params::RegionSpec`]).
-#[derive(Debug, Clone, Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct OpeningCfg {
-    /// m, box coordinates (origin at the centre of the box's bottom face).
-    pub centre: [f64; 3],
-    /// m, extent along x, y, z.
-    pub size: [f64; 3],
-}
-
-/// A spring holding a floating body (see [`sph::params::SpringSpec`]).
-#[derive(Debug, Clone, Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct SpringCfg {
-    /// m, box coordinates.
-    pub attach: [f64; 3],
-    /// m, tank frame.
-    pub anchor: [f64; 3],
-    /// N/m (2D: per metre of breadth).
-    pub stiffness: f64,
-    #[serde(default)]
-    pub rest_length: f64,
-}
-
-/// A floating body under `bodies.NAME` (see [`sph::params::BodySpec`]); openings and springs are maps by
-/// name, as ROS 2 parameters nest.
-#[derive(Debug, Clone, Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct BodyCfg {
-    pub size: [f64; 3],
-    pub wall_thickness: f64,
-    pub position: [f64; 3],
-    pub mass: f64,
-    pub inertia: [f64; 3],
-    pub centre_of_gravity: [f64; 3],
-    /// m/s and rad/s at the start (free decay).
-    #[serde(default)]
-    pub velocity: [f64; 3],
-    #[serde(default)]
-    pub angular_velocity: [f64; 3],
-    #[serde(default)]
-    pub fixed: Vec<sph::params::Dof>,
-    #[serde(default)]
-    pub openings: std::collections::BTreeMap<String, OpeningCfg>,
-    /// Internal walls dividing the hollow, as boxes like the openings.
-    #[serde(default)]
-    pub bulkheads: std::collections::BTreeMap<String, OpeningCfg>,
-    #[serde(default)]
-    pub springs: std::collections::BTreeMap<String, SpringCfg>,
-}
-
-fn regions(m: &std::collections::BTreeMap<String, OpeningCfg>) -> Vec<sph::params::RegionSpec> {
-    m.iter()
-        .map(|(n, o)| sph::params::RegionSpec {
-            name: n.clone(),
-            centre: o.centre,
-            size: o.size,
-        })
-        .collect()
-}
-
-impl BodyCfg {
-    fn spec(&self, name: &str) -> sph::params::BodySpec {
-        sph::params::BodySpec {
-            name: name.to_string(),
-            size: self.size,
-            wall_thickness: self.wall_thickness,
-            position: self.position,
-            mass: self.mass,
-            inertia: self.inertia,
-            centre_of_gravity: self.centre_of_gravity,
-            velocity: self.velocity,
-            angular_velocity: self.angular_velocity,
-            fixed: self.fixed.clone(),
-            openings: regions(&self.openings),
-            bulkheads: regions(&self.bulkheads),
-            springs: self
-                .springs
-                .iter()
-                .map(|(n, k)| sph::params::SpringSpec {
-                    name: n.clone(),
-                    attach: k.attach,
-                    anchor: k.anchor,
-                    stiffness: k.stiffness,
-                    rest_length: k.rest_length,
-                })
-                .collect(),
-        }
-    }
-}
-
-#[derive(Debug, Clone, Default, Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Probes {
-    pub names: Vec<String>,
-    /// m, tank frame.
-    pub x: Vec<f64>,
-    pub y: Vec<f64>,
-}
-
-#[derive(Debug, Clone, Default, Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Sensors {
-    pub names: Vec<String>,
-    pub x: Vec<f64>,
-    pub y: Vec<f64>,
-    pub z: Vec<f64>,
-}
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -289,20 +183,22 @@ pub struct RunConfig {
     pub gravity: f64,
     #[serde(default)]
     pub solver: SolverSpec,
-    #[serde(default)]
-    pub probes: Probes,
-    #[serde(default)]
-    pub pressure_sensors: Sensors,
+    /// Wave probes, as columns (`names`, `x`, `y`).
+    #[serde(default, with = "sph::params::records::probes")]
+    pub probes: Vec<ProbeSpec>,
+    /// Pressure sensors, as columns (`names`, `x`, `y`, `z`).
+    #[serde(default, with = "sph::params::records::sensors")]
+    pub pressure_sensors: Vec<SensorSpec>,
     /// Floating bodies by name (the tank is then the basin around them).
-    #[serde(default)]
-    pub bodies: std::collections::BTreeMap<String, BodyCfg>,
+    #[serde(default, with = "sph::params::records::by_name")]
+    pub bodies: Vec<BodySpec>,
     /// A piston wave maker at the tank's −x end.
     #[serde(default)]
     pub wave_maker: Option<sph::params::PistonSpec>,
     /// Fixed obstacles by name: solid boxes of wall particles fixed to the tank, centre and size in the tank
     /// frame (origin at the centre of the tank bottom).
-    #[serde(default)]
-    pub obstacles: std::collections::BTreeMap<String, OpeningCfg>,
+    #[serde(default, with = "sph::params::records::by_name")]
+    pub obstacles: Vec<RegionSpec>,
     /// Rows per simulated second in the outputs.
     #[serde(default = "default_rate")]
     pub output_rate_hz: f64,
@@ -1020,45 +916,22 @@ impl Loaded {
     fn sim_params_here(&self) -> Result<SimParams, ConfigError> {
         let c = &self.config;
         let src = self.source_name.as_str();
-        let n = c.probes.names.len();
-        if c.probes.x.len() != n || !(c.probes.y.len() == n || c.probes.y.is_empty()) {
-            return Err(key_err(src, "probes", format!("probes.names, probes.x and probes.y must have the same length (got {}, {}, {}); probes.y may be omitted in 2D", n, c.probes.x.len(), c.probes.y.len())));
-        }
-        let probes = (0..n)
-            .map(|i| ProbeSpec {
-                name: c.probes.names[i].clone(),
-                x: c.probes.x[i],
-                y: c.probes.y.get(i).copied().unwrap_or(0.0),
-            })
-            .collect();
-        let s = &c.pressure_sensors;
-        let n = s.names.len();
-        if s.x.len() != n || s.z.len() != n || !(s.y.len() == n || s.y.is_empty()) {
-            return Err(key_err(src, "pressure_sensors", format!("pressure_sensors.names, .x, .y and .z must have the same length (got {}, {}, {}, {}); .y may be omitted in 2D", n, s.x.len(), s.y.len(), s.z.len())));
-        }
-        let sensors = (0..n)
-            .map(|i| SensorSpec {
-                name: s.names[i].clone(),
-                x: s.x[i],
-                y: s.y.get(i).copied().unwrap_or(0.0),
-                z: s.z[i],
-            })
-            .collect();
+        let probes: Vec<&str> = c.probes.iter().map(|p| p.name.as_str()).collect();
+        let sensors: Vec<&str> = c.pressure_sensors.iter().map(|p| p.name.as_str()).collect();
         for (what, names) in [
-            ("probes.names", &c.probes.names),
-            ("pressure_sensors.names", &s.names),
+            ("probes.names", probes),
+            ("pressure_sensors.names", sensors),
         ] {
-            for (i, name) in names.iter().enumerate() {
+            for (i, &name) in names.iter().enumerate() {
                 if name.is_empty()
                     || name.contains(',')
                     || name.contains('"')
-                    || names[..i].contains(name)
+                    || names[..i].contains(&name)
                 {
                     return Err(key_err(src, what, format!("`{name}` must be non-empty, unique and free of commas and quotes (it becomes a CSV column)")));
                 }
             }
         }
-        let bodies = c.bodies.iter().map(|(n, b)| b.spec(n)).collect();
         let p = SimParams {
             dimension: c.dimension,
             tank: c.tank.clone(),
@@ -1070,11 +943,11 @@ impl Loaded {
             fluid: c.fluid.clone(),
             gravity: c.gravity,
             solver: c.solver.clone(),
-            probes,
-            pressure_sensors: sensors,
-            bodies,
+            probes: c.probes.clone(),
+            pressure_sensors: c.pressure_sensors.clone(),
+            bodies: c.bodies.clone(),
             wave_maker: c.wave_maker.clone(),
-            obstacles: regions(&c.obstacles),
+            obstacles: c.obstacles.clone(),
         };
         p.validate()
             .map_err(|e| key_err(src, &e.field, e.message))?;

@@ -14,6 +14,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegionSpec {
+    /// Its key in the map of its kind (`records::by_name`).
+    #[serde(skip)]
     pub name: String,
     /// Centre, box coordinates, m.
     pub centre: [f64; 3],
@@ -26,6 +28,8 @@ pub struct RegionSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpringSpec {
+    /// Its key in the map of its kind (`records::by_name`).
+    #[serde(skip)]
     pub name: String,
     /// Where it is attached, box coordinates, m.
     pub attach: [f64; 3],
@@ -76,6 +80,8 @@ impl Dof {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
+    /// Its key in the map of its kind (`records::by_name`).
+    #[serde(skip)]
     pub name: String,
     /// Outer length (x), breadth (y; unused in 2D) and height (z), m.
     pub size: [f64; 3],
@@ -99,12 +105,12 @@ pub struct BodySpec {
     /// Degrees of freedom held at their start values.
     #[serde(default)]
     pub fixed: Vec<Dof>,
-    #[serde(default)]
+    #[serde(default, with = "super::records::by_name")]
     pub openings: Vec<RegionSpec>,
     /// Internal walls (openings cut them too).
-    #[serde(default)]
+    #[serde(default, with = "super::records::by_name")]
     pub bulkheads: Vec<RegionSpec>,
-    #[serde(default)]
+    #[serde(default, with = "super::records::by_name")]
     pub springs: Vec<SpringSpec>,
 }
 

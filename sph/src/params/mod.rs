@@ -2,6 +2,7 @@
 //! Plain data with defaults; [`SimParams::validate`] names the offending field of anything unusable.
 
 mod bodies;
+pub mod records;
 mod validate;
 mod wave_maker;
 
@@ -328,17 +329,19 @@ pub struct SimParams {
     /// m/s².
     pub gravity: f64,
     pub solver: SolverSpec,
+    #[serde(default, with = "records::probes")]
     pub probes: Vec<ProbeSpec>,
+    #[serde(default, with = "records::sensors")]
     pub pressure_sensors: Vec<SensorSpec>,
-    /// Floating bodies in the tank (which then serves as the basin around them).
-    #[serde(default)]
+    /// Floating bodies in the tank (which then serves as the basin around them), by name.
+    #[serde(default, with = "records::by_name")]
     pub bodies: Vec<BodySpec>,
     /// A piston wave maker at the tank's −x end.
     #[serde(default)]
     pub wave_maker: Option<PistonSpec>,
     /// Fixed obstacles: solid boxes of wall particles fixed to the tank (a block on the floor, a baffle), by
-    /// centre and size in the tank frame (origin at the centre of the tank bottom).
-    #[serde(default)]
+    /// centre and size in the tank frame (origin at the centre of the tank bottom), by name.
+    #[serde(default, with = "records::by_name")]
     pub obstacles: Vec<RegionSpec>,
 }
 
