@@ -1,9 +1,10 @@
-//! The discharge coefficient of a slot in a damaged box's bottom against the slot's width in particle
-//! spacings, with both schemes (`sph::flooding`): prints the manual's table (guide/flooding.md).
+//! The discharge coefficient of a slot against its width in particle spacings, with both schemes
+//! (`sph::flooding::slot_case`: a reservoir emptying through a slot in its wall into a dry compartment):
+//! prints the manual's table (guide/flooding.md).
 //!
 //!     cargo run --release -p slosh-sph --example discharge_coefficient [-- --dp 0.005]
 
-use sph::flooding::{case, discharge};
+use sph::flooding::{slot_case, slot_discharge};
 use sph::params::Scheme;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -13,27 +14,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .position(|a| a == "--dp")
         .and_then(|i| args.get(i + 1))
         .map_or(Ok(0.005), |s| s.parse::<f64>())?;
-    println!("| scheme | slot, spacings | slot, mm | C_d (windows of 0.1 s from 0.1 s, head above 3 cm) | mean |");
-    println!("|---|---|---|---|---|");
+    println!("| scheme | slot, spacings | slot, mm | C_d per window (0.1 s from 0.2 s) | mean | head, m |");
+    println!("|---|---|---|---|---|---|");
     for scheme in [Scheme::Wcsph, Scheme::Dfsph] {
         for opening in [4.0, 8.0, 12.0, 16.0] {
-            let d = discharge(case(scheme, opening, dp), 0.6, 0.02, (0.1, 0.1))?;
-            let cds: Vec<f64> = d
-                .windows
-                .iter()
-                .filter(|w| w.head > 0.03)
-                .map(|w| w.cd)
-                .collect();
+            let d = slot_discharge(slot_case(scheme, opening, dp), 0.6, 0.02, (0.2, 0.1))?;
+            let cds: Vec<f64> = d.windows.iter().map(|w| w.cd).collect();
             let mean = cds.iter().sum::<f64>() / cds.len().max(1) as f64;
             let list: Vec<String> = cds.iter().map(|c| format!("{c:.2}")).collect();
+            let heads = (d.windows.first(), d.windows.last());
+            let (Some(first), Some(last)) = heads else {
+                return Err("no window: the run is shorter than its settling time".into());
+            };
             println!(
-                "| {} | {opening} | {:.0} | {} | {mean:.2} |",
+                "| {} | {opening} | {:.0} | {} | {mean:.2} | {:.3}–{:.3} |",
                 match scheme {
                     Scheme::Wcsph => "wcsph",
                     Scheme::Dfsph => "dfsph",
                 },
                 d.width * 1000.0,
-                list.join(", ")
+                list.join(", "),
+                first.head,
+                last.head
             );
         }
     }
