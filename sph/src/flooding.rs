@@ -117,23 +117,20 @@ pub fn discharge(
     let floor = DEPTH - DRAUGHT + WALL;
     let inner = BOX - 2.0 * WALL;
     // Head across the slot: the basin's level over the level inside (its volume over its width).
-    let head = |s: &Sample| s.level - (floor + s.body.flooded_volume / inner);
-    let w = (window / every).round() as usize;
-    let mut i = (settle / every).round() as usize;
-    let mut windows = Vec::new();
-    while i + w < samples.len() {
-        let (a, b) = (&samples[i], &samples[i + w]);
-        let inflow = (b.body.flooded_volume - a.body.flooded_volume) / (b.time - a.time);
-        let dh = 0.5 * (head(a) + head(b));
-        windows.push(Window {
-            from: a.time,
-            to: b.time,
-            head: dh,
-            inflow,
-            cd: inflow / (width * (2.0 * g * dh.max(0.0)).sqrt()),
-        });
-        i += w;
-    }
+    let series: Vec<(f64, f64, f64)> = samples
+        .iter()
+        .map(|s| {
+            let head = s.level - (floor + s.body.flooded_volume / inner);
+            (s.time, head, s.body.flooded_volume)
+        })
+        .collect();
+    let windows = windows(
+        &series,
+        width,
+        g,
+        (settle / every).round() as usize,
+        window / every,
+    );
     Ok(Discharge {
         width,
         samples,
@@ -209,27 +206,39 @@ pub fn slot_discharge(
         let o = sim.observe(&AtRest)?;
         samples.push((o.time, o.probes[0], behind(sim.as_ref())));
     }
+    // The head over the slot's centre, and the volume that has passed it.
     let centre = sill + 0.5 * width;
-    let w = (window / every).round() as usize;
-    let mut i = (settle / every).round() as usize - 1;
-    let mut windows = Vec::new();
-    while i + w < samples.len() {
-        let (a, b) = (samples[i], samples[i + w]);
-        let inflow = (a.2 - b.2) / (b.0 - a.0);
-        let head = 0.5 * (a.1 + b.1) - centre;
-        windows.push(Window {
-            from: a.0,
-            to: b.0,
-            head,
-            inflow,
-            cd: inflow / (width * (2.0 * g * head.max(0.0)).sqrt()),
-        });
-        i += w;
-    }
+    let series: Vec<(f64, f64, f64)> = samples
+        .iter()
+        .map(|&(t, level, behind)| (t, level - centre, -behind))
+        .collect();
+    let first = ((settle / every).round() as usize).saturating_sub(1);
+    let windows = windows(&series, width, g, first, window / every);
     Ok(SlotDischarge {
         width,
         samples,
         windows,
         lost: sim.counts().lost as u64,
     })
+}
+
+/// C_d over windows of `per` samples from sample `first` on, of a series of (time, head across the slot,
+/// the volume that has passed it): the flow over each window against its mean head.
+fn windows(series: &[(f64, f64, f64)], width: f64, g: f64, first: usize, per: f64) -> Vec<Window> {
+    let w = per.round() as usize;
+    (first..series.len().saturating_sub(w))
+        .step_by(w.max(1))
+        .map(|i| {
+            let (a, b) = (series[i], series[i + w]);
+            let inflow = (b.2 - a.2) / (b.0 - a.0);
+            let head = 0.5 * (a.1 + b.1);
+            Window {
+                from: a.0,
+                to: b.0,
+                head,
+                inflow,
+                cd: inflow / (width * (2.0 * g * head.max(0.0)).sqrt()),
+            }
+        })
+        .collect()
 }

@@ -9,6 +9,44 @@ use serde::de::{DeserializeOwned, Error as _};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::collections::BTreeMap;
 
+/// The rows of columns that must each be as long as `names`, or, the `optional` ones, empty (read as 0):
+/// the error names the group `what` and its columns.
+fn rows<const N: usize>(
+    what: &str,
+    names: &[String],
+    columns: [(&str, &[f64], bool); N],
+) -> Result<Vec<[f64; N]>, String> {
+    let n = names.len();
+    if columns
+        .iter()
+        .any(|(_, c, optional)| c.len() != n && !(*optional && c.is_empty()))
+    {
+        let keys: Vec<String> = std::iter::once("names")
+            .chain(columns.iter().map(|c| c.0))
+            .map(|k| format!("{what}.{k}"))
+            .collect();
+        let lengths: Vec<String> = std::iter::once(n)
+            .chain(columns.iter().map(|c| c.1.len()))
+            .map(|l| l.to_string())
+            .collect();
+        let optional: Vec<String> = columns
+            .iter()
+            .filter(|c| c.2)
+            .map(|c| format!("; {what}.{} may be omitted in 2D", c.0))
+            .collect();
+        let (last, rest) = keys.split_last().expect("names and a column");
+        return Err(format!(
+            "{} and {last} must have the same length (got {}){}",
+            rest.join(", "),
+            lengths.join(", "),
+            optional.concat()
+        ));
+    }
+    Ok((0..n)
+        .map(|i| std::array::from_fn(|k| columns[k].1.get(i).copied().unwrap_or(0.0)))
+        .collect())
+}
+
 /// Probes as the columns `names`, `x`, `y`.
 pub mod probes {
     use super::*;
@@ -32,22 +70,11 @@ pub mod probes {
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<ProbeSpec>, D::Error> {
         let c = Columns::deserialize(d)?;
-        let n = c.names.len();
-        if c.x.len() != n || !(c.y.len() == n || c.y.is_empty()) {
-            return Err(D::Error::custom(format!(
-                "probes.names, probes.x and probes.y must have the same length (got {}, {}, {}); \
-                 probes.y may be omitted in 2D",
-                n,
-                c.x.len(),
-                c.y.len()
-            )));
-        }
-        Ok((0..n)
-            .map(|i| ProbeSpec {
-                name: c.names[i].clone(),
-                x: c.x[i],
-                y: c.y.get(i).copied().unwrap_or(0.0),
-            })
+        let rows = rows("probes", &c.names, [("x", &c.x, false), ("y", &c.y, true)]);
+        Ok(c.names
+            .into_iter()
+            .zip(rows.map_err(D::Error::custom)?)
+            .map(|(name, [x, y])| ProbeSpec { name, x, y })
             .collect())
     }
 }
@@ -77,24 +104,16 @@ pub mod sensors {
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<SensorSpec>, D::Error> {
         let c = Columns::deserialize(d)?;
-        let n = c.names.len();
-        if c.x.len() != n || c.z.len() != n || !(c.y.len() == n || c.y.is_empty()) {
-            return Err(D::Error::custom(format!(
-                "pressure_sensors.names, .x, .y and .z must have the same length (got {}, {}, {}, {}); \
-                 .y may be omitted in 2D",
-                n,
-                c.x.len(),
-                c.y.len(),
-                c.z.len()
-            )));
-        }
-        Ok((0..n)
-            .map(|i| SensorSpec {
-                name: c.names[i].clone(),
-                x: c.x[i],
-                y: c.y.get(i).copied().unwrap_or(0.0),
-                z: c.z[i],
-            })
+        let columns = [
+            ("x", &c.x[..], false),
+            ("y", &c.y, true),
+            ("z", &c.z, false),
+        ];
+        let rows = rows("pressure_sensors", &c.names, columns);
+        Ok(c.names
+            .into_iter()
+            .zip(rows.map_err(D::Error::custom)?)
+            .map(|(name, [x, y, z])| SensorSpec { name, x, y, z })
             .collect())
     }
 }
