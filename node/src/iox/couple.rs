@@ -232,10 +232,8 @@ struct Reply<'a> {
 
 impl Sink for Reply<'_> {
     fn observed(&mut self, out: &Output) -> Result<(), SinkError> {
-        let mut answer = outputs_of(out.seconds, out.observation);
-        answer.steps = out.steps as u32;
         // A client that has gone does not get its answer: nothing else to do.
-        let _ = self.request.send_copy(answer);
+        let _ = self.request.send_copy(outputs_at(out));
         let _ = self.notifier.notify();
         Ok(())
     }

@@ -168,12 +168,18 @@ impl OutputPorts {
     }
 }
 
-/// The outputs over iceoryx2, with the solver steps since the previous output.
+/// A drive loop's output as [`StepOutputs`]: at its stamp in seconds, with the solver steps since the
+/// previous output.
+pub fn outputs_at(out: &crate::sinks::Output) -> StepOutputs {
+    let mut o = outputs_of(out.seconds, out.observation);
+    o.steps = out.steps as u32;
+    o
+}
+
+/// The outputs over iceoryx2.
 impl crate::sinks::Sink for OutputPorts {
     fn observed(&mut self, out: &crate::sinks::Output) -> Result<(), crate::sinks::SinkError> {
-        let mut o = outputs_of(out.seconds, out.observation);
-        o.steps = out.steps as u32;
-        Ok(self.publish(&o)?)
+        Ok(self.publish(&outputs_at(out))?)
     }
 }
 
