@@ -84,6 +84,8 @@ struct Row {
     bound: String,
     /// Whether the bound holds (None: no bound).
     ok: Option<bool>,
+    /// Whether a target that is not asserted yet is met (shown as inside or outside).
+    target: Option<bool>,
 }
 
 /// The numbers of one validation case (`name`, as its figure): each simulated quantity beside what it is
@@ -127,6 +129,26 @@ impl Results {
             reference,
             bound: bound.into(),
             ok,
+            target: None,
+        });
+    }
+
+    /// A row held to a target that is not asserted (yet): the table says whether it is met.
+    fn target(
+        &mut self,
+        quantity: &str,
+        simulated: String,
+        reference: String,
+        bound: &str,
+        met: bool,
+    ) {
+        self.rows.push(Row {
+            quantity: quantity.into(),
+            simulated,
+            reference,
+            bound: bound.into(),
+            ok: None,
+            target: Some(met),
         });
     }
 
@@ -143,10 +165,12 @@ impl Results {
         );
         t.push_str("| quantity | simulated | reference | bound | |\n|---|---|---|---|---|\n");
         for r in &self.rows {
-            let mark = match r.ok {
-                Some(true) => "pass",
-                Some(false) => "**fails**",
-                None => "",
+            let mark = match (r.ok, r.target) {
+                (Some(true), _) => "pass",
+                (Some(false), _) => "**fails**",
+                (None, Some(true)) => "inside",
+                (None, Some(false)) => "outside",
+                (None, None) => "",
             };
             t.push_str(&format!(
                 "| {} | {} | {} | {} | {mark} |\n",
@@ -400,8 +424,10 @@ fn faltinsen_2000(overrides: &[&str], name: &str, scheme: &str, rms_ratio: std::
 fn spheric10_sensor1_impacts_come_at_the_measured_times() {
     spheric10(
         &["solver.boundary.method=mirror"],
+        0.008,
         "spheric10_sensor1",
         "WCSPH, dp 8 mm, mirror walls",
+        true,
     );
 }
 
@@ -410,15 +436,55 @@ fn spheric10_sensor1_impacts_come_at_the_measured_times() {
 fn spheric10_sensor1_impacts_come_at_the_measured_times_dfsph() {
     spheric10(
         &["solver.scheme=dfsph"],
+        0.008,
         "spheric10_sensor1_dfsph",
         "DFSPH, dp 8 mm",
+        true,
     );
 }
 
-/// SPHERIC Test 10 (water, low fill), pressure sensor 1 under the measured roll law: the first three impacts
-/// come within 0.1 s of the measured ones and the slow pressure between impacts within 25 %; `overrides` on
-/// top of dp 8 mm; draws the figure `name`.
-fn spheric10(overrides: &[&str], name: &str, label: &str) {
+/// The incompressible scheme at 4 and 2 mm, and with corrected kernel gradients at 4 mm, against the
+/// targets alone (nothing asserted: at 4 mm the slow pressure after the first impact is 30 % high, outside
+/// the 8 mm runs' 25 %). About two minutes; the manual's page shows the tables of the last run that updated
+/// it.
+#[test]
+#[ignore = "a resolution study, run by hand: see the manual's SPHERIC Test 10 page"]
+fn spheric10_sensor1_dfsph_at_finer_spacings() {
+    for (overrides, dp, name, label) in [
+        (
+            &["solver.scheme=dfsph"][..],
+            0.004,
+            "spheric10_sensor1_dfsph_dp4mm",
+            "DFSPH, dp 4 mm",
+        ),
+        (
+            &["solver.scheme=dfsph"][..],
+            0.002,
+            "spheric10_sensor1_dfsph_dp2mm",
+            "DFSPH, dp 2 mm",
+        ),
+        (
+            &["solver.scheme=dfsph", "solver.dfsph.kernel_correction=true"][..],
+            0.004,
+            "spheric10_sensor1_dfsph_corrected_dp4mm",
+            "DFSPH with corrected kernel gradients, dp 4 mm",
+        ),
+    ] {
+        spheric10(overrides, dp, name, label, false);
+    }
+}
+
+/// The first three impacts' peaks at sensor 1 over the experiment's ~100 repeats, mean and standard
+/// deviation (Pa): Souto-Iglesias, Botia-Vera & Bulian (2011), as a public analysis of the repeatability
+/// file gives them (see the manual's page).
+const SPHERIC10_REPEATS: [(f64, f64); 3] = [(3710.0, 730.0), (4820.0, 1500.0), (4690.0, 1710.0)];
+
+/// SPHERIC Test 10 (water, low fill), pressure sensor 1 under the measured roll law at spacing `dp`, with
+/// `overrides`; draws the figure `name`. With `asserted`, the first three impacts come within 0.1 s of the
+/// measured ones and the slow pressure before the first and after it within 25 %; always, the table shows
+/// the targets: impacts within 30 ms, their peaks inside the repeats' mean ± 2σ, the slow pressure between
+/// impacts within 15 %.
+fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str, asserted: bool) {
     let started = std::time::Instant::now();
     let mut r = Results::new(name, "spheric10.md", &format!("{label}, 0-6 s"), started);
     let rows = table(&read("spheric10_dualsphysics/CaseSloshingMotionData.dat"));
@@ -438,7 +504,8 @@ fn spheric10(overrides: &[&str], name: &str, label: &str) {
     ));
     exp.sort_by(|a, b| a[0].total_cmp(&b[0]));
     let t_end = 6.0;
-    let mut o = vec!["particle_spacing=0.008", "motion.source=none"];
+    let spacing = format!("particle_spacing={dp}");
+    let mut o = vec![spacing.as_str(), "motion.source=none"];
     o.extend_from_slice(overrides);
     let (t, _, p) = run("spheric10", &o, &motion, t_end, 0.002);
     let mut peaks: Vec<(f64, f64)> = vec![];
@@ -467,7 +534,7 @@ fn spheric10(overrides: &[&str], name: &str, label: &str) {
             series("measured", &te, &pe, true),
         ],
     );
-    for &t_peak in &[2.375, 4.067, 5.672] {
+    for (&t_peak, &(mean, sd)) in [2.375, 4.067, 5.672].iter().zip(&SPHERIC10_REPEATS) {
         let window = |lo: f64, hi: f64| {
             t.iter()
                 .zip(&p)
@@ -482,25 +549,39 @@ fn spheric10(overrides: &[&str], name: &str, label: &str) {
             .map(|r| r[1])
             .fold(f64::MIN, f64::max);
         eprintln!("SPHERIC 10 ({label}) impact near {t_peak} s: simulated peak {ps:.0} Pa at {ts:.3} s, measured {pe:.0} Pa");
-        r.row(
-            &format!("impact near {t_peak} s: time"),
-            format!("{ts:.3} s"),
+        if asserted {
+            r.row(
+                &format!("impact near {t_peak} s: time"),
+                format!("{ts:.3} s"),
+                format!("{t_peak:.3} s"),
+                "± 0.1 s",
+                Some((ts - t_peak).abs() < 0.1),
+            );
+        }
+        r.target(
+            &format!("impact near {t_peak} s: time, against the target"),
+            format!("{:+.0} ms", (ts - t_peak) * 1e3),
             format!("{t_peak:.3} s"),
-            "± 0.1 s",
-            Some((ts - t_peak).abs() < 0.1),
+            "± 30 ms",
+            (ts - t_peak).abs() <= 0.03,
         );
-        // Magnitudes are printed, not asserted: repetitions scatter by tens of percent, and single-sample
-        // spikes reach several times the measured peaks.
-        r.row(
+        // Repetitions scatter by tens of percent: the target is the repeats' spread, not the one record.
+        r.target(
             &format!("impact near {t_peak} s: peak (one sample)"),
             format!("{:.1} kPa", ps / 1000.0),
-            format!("{:.1} kPa", pe / 1000.0),
-            "printed, not asserted",
-            None,
+            format!(
+                "{:.1} ± {:.1} kPa over the repeats (record {:.1})",
+                mean / 1000.0,
+                sd / 1000.0,
+                pe / 1000.0
+            ),
+            "mean ± 2σ",
+            (ps - mean).abs() <= 2.0 * sd,
         );
     }
     // Between impacts the pressure is the slow part of the flow, which the record resolves well: the
-    // sensor's mean over the rise before the first impact and over the run-up after it.
+    // sensor's mean over the rise before the first impact, over the run-up after it, and after the second
+    // and third impacts.
     let mean_in = |ts: &[f64], ys: &[f64], lo: f64, hi: f64| {
         let v: Vec<f64> = ts
             .iter()
@@ -510,15 +591,25 @@ fn spheric10(overrides: &[&str], name: &str, label: &str) {
             .collect();
         v.iter().sum::<f64>() / v.len().max(1) as f64
     };
-    for (lo, hi) in [(0.6, 1.2), (2.45, 2.85)] {
+    for (lo, hi) in [(0.6, 1.2), (2.45, 2.85), (4.15, 4.45), (5.75, 6.0)] {
         let (ms, me) = (mean_in(&t, &p, lo, hi), mean_in(&te, &pe, lo, hi));
         eprintln!("SPHERIC 10 ({label}) mean pressure {lo}-{hi} s: simulated {ms:.0} Pa, measured {me:.0} Pa");
-        r.row(
-            &format!("mean pressure {lo}-{hi} s"),
-            format!("{ms:.0} Pa"),
+        let quantity = format!("mean pressure {lo}-{hi} s");
+        if asserted && hi < 3.0 {
+            r.row(
+                &quantity,
+                format!("{ms:.0} Pa"),
+                format!("{me:.0} Pa"),
+                "± 25 %",
+                Some((ms - me).abs() < 0.25 * me),
+            );
+        }
+        r.target(
+            &format!("{quantity}, against the target"),
+            format!("{:+.0} %", (ms / me - 1.0) * 100.0),
             format!("{me:.0} Pa"),
-            "± 25 %",
-            Some((ms - me).abs() < 0.25 * me),
+            "± 15 %",
+            (ms - me).abs() <= 0.15 * me,
         );
     }
     r.publish_and_check();
