@@ -349,6 +349,42 @@ fn small_bench(extra: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// `bench/scaling/run` with a built `slosh`: a row per thread count with its speed-up over the first, and a
+/// row per finer spacing with its particle count.
+#[test]
+fn the_scaling_script_prints_a_row_per_thread_count_and_per_spacing() {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scaling/run");
+    let st = std::process::Command::new(script)
+        .args(["--slosh", env!("CARGO_BIN_EXE_slosh")])
+        .args(["--case", "seed_2d_dp8mm_dfsph", "--duration", "0.02"])
+        .args(["--threads", "1,2", "--spacings", "0.02,0.016"])
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&st.stdout);
+    assert!(
+        st.status.success(),
+        "{out}{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let rows: Vec<Vec<&str>> = out
+        .lines()
+        .filter(|l| {
+            l.starts_with("| ") && !l.starts_with("| threads") && !l.starts_with("| spacing")
+        })
+        .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
+        .collect();
+    assert_eq!(rows.len(), 4, "{out}");
+    assert_eq!(
+        (rows[0][0], rows[0][5], rows[0][6]),
+        ("1", "1.00", "100 %"),
+        "{out}"
+    );
+    assert_eq!(rows[1][0], "2", "{out}");
+    // Both coarser than the case's own 8 mm: fewer liquid particles at 20 mm than at 16 mm.
+    let liquid = |r: &Vec<&str>| r[1].parse::<usize>().unwrap();
+    assert!(liquid(&rows[2]) < liquid(&rows[3]), "{out}");
+}
+
 #[test]
 fn bench_repeats_a_case_and_reports_the_median_run_with_the_fastest_and_slowest() {
     let st = small_bench(&["--repeat", "3"]);
