@@ -277,7 +277,7 @@ pub fn drive(
                 "iterations": stats.solver_iterations,
                 "iterations_per_step": stats.solver_iterations as f64 / stats.steps.max(1) as f64,
                 "max_density_error": stats.max_density_error,
-                "tolerance": params.solver.dfsph.max_density_error,
+                "tolerance": params.density_tolerance(),
                 "unconverged_steps": stats.unconverged_steps,
                 "retried_steps": stats.retried_steps,
             })

@@ -742,6 +742,31 @@ fn dfsph_dam_break_front_follows_martin_and_moyce() {
     assert_eq!(sim.stats().unconverged_steps, 0);
 }
 
+/// A liquid 119 particle spacings deep, released from rest, carries its weight on the walls over its first
+/// 80 ms (within 5 %: the column's start-up oscillation averages out over the window): the solver's
+/// tolerance falls with the depth squared (`DfsphSpec::density_tolerance`). At a fixed 1e-4 the walls of
+/// this tank carry 81 % of the weight over the same window, and a tank of the seed tank's length blows up.
+#[test]
+fn dfsph_deep_liquid_released_from_rest_carries_its_weight() {
+    let p = dfsph(tank2d(0.2, 0.6, 0.19, 0.0016));
+    let layers = p.fill.height / p.particle_spacing;
+    assert!(layers > 118.0, "{layers} layers");
+    assert!(p.density_tolerance() < 0.2 * p.solver.dfsph.max_density_error);
+    let mut sim = sph::build(p).unwrap();
+    let weight = sim.liquid_mass() * G;
+    let o = run_and_average(sim.as_mut(), &AtRest, 0.02, 0.08, 0.01);
+    let fz = -o.wrench.force[2];
+    eprintln!(
+        "deep: walls carry {fz:.1} N of {weight:.1} N, {:?}",
+        sim.stats()
+    );
+    assert!(
+        (fz - weight).abs() < 0.05 * weight,
+        "walls carry {fz:.1} N of the liquid's {weight:.1} N"
+    );
+    assert_eq!(sim.counts().lost, 0, "particles left the tank");
+}
+
 #[test]
 fn dfsph_accelerating_tank_tilts_the_surface_and_pushes_back() {
     check_accelerating(dfsph(tank2d(0.8, 0.6, 0.39, 0.02)));

@@ -69,7 +69,9 @@ pub struct DfsphSpec {
     pub cfl: f64,
     /// Largest time step, s.
     pub dt_max: f64,
-    /// Mean predicted density error the constant-density solver reaches every step (fraction of ρ0).
+    /// Mean predicted density error the constant-density solver reaches every step (fraction of ρ0), in a
+    /// liquid up to [`DfsphSpec::TOLERANCE_LAYERS`] particle spacings deep; deeper, the solver holds a
+    /// tighter one ([`DfsphSpec::density_tolerance`]).
     pub max_density_error: f64,
     /// Mean density change per step the divergence solver leaves (fraction of ρ0).
     pub max_divergence_error: f64,
@@ -103,6 +105,21 @@ pub struct DfsphSpec {
 }
 
 impl DfsphSpec {
+    /// Depth of liquid, in particle spacings, up to which the constant-density solver holds
+    /// `max_density_error` itself.
+    pub const TOLERANCE_LAYERS: f64 = 50.0;
+
+    /// The mean density error the constant-density solver holds in a liquid `layers` particle spacings
+    /// deep: `max_density_error`, times (`TOLERANCE_LAYERS` / layers)² deeper. The Jacobi iterations
+    /// build the liquid's weight one layer of particles an iteration, so the error left in that smoothest
+    /// mode, for the same mean error, grows with the square of the depth; at a fixed tolerance a deep
+    /// liquid released from rest sags onto its floor, or blows up (measured in the manual's
+    /// incompressible-scheme decisions, "A deep liquid's start").
+    pub fn density_tolerance(&self, layers: f64) -> f64 {
+        let scale = (Self::TOLERANCE_LAYERS / layers.max(1.0)).min(1.0);
+        self.max_density_error * scale * scale
+    }
+
     /// The Jacobi relaxation the solver uses: `relaxation`, or by configuration (0.5 where the kernel
     /// gradients are corrected, `corrected`, 0.7 where not).
     pub fn relaxation(&self, corrected: bool) -> f64 {
@@ -358,6 +375,14 @@ pub struct ParamError {
 pub const MAX_PARTICLES: f64 = (1u64 << 31) as f64;
 
 impl SimParams {
+    /// The mean density error the incompressible scheme's constant-density solver holds for this liquid
+    /// ([`DfsphSpec::density_tolerance`] at the fill's depth in particle spacings).
+    pub fn density_tolerance(&self) -> f64 {
+        self.solver
+            .dfsph
+            .density_tolerance(self.fill.height / self.particle_spacing)
+    }
+
     /// A closed `tank` filled to `fill` m over its whole length at spacing `dp`, in `dimension` 2 or 3,
     /// with the default fluid (water), gravity 9.81 m/s² and solver, and no probes, sensors, bodies, wave
     /// maker or obstacles.

@@ -560,4 +560,20 @@ mod tests {
         assert_eq!(e.field, "pressure_sensors", "{}", e.message);
         assert!(e.message.contains("block"), "{}", e.message);
     }
+
+    #[test]
+    fn the_density_tolerance_is_the_setting_up_to_50_layers_and_falls_with_the_depth_squared_beyond(
+    ) {
+        let mut p = seed();
+        let tol = p.solver.dfsph.max_density_error;
+        // 19 layers, and 50.
+        assert_eq!(p.density_tolerance(), tol);
+        p.particle_spacing = 0.19 / 50.0;
+        assert_eq!(p.density_tolerance(), tol);
+        // 100 layers: a quarter; 150: a ninth.
+        p.particle_spacing = 0.0019;
+        assert!((p.density_tolerance() - 0.25 * tol).abs() < 1e-9 * tol);
+        p.particle_spacing = 0.19 / 150.0;
+        assert!((p.density_tolerance() - tol / 9.0).abs() < 1e-9 * tol);
+    }
 }

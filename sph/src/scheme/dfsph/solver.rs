@@ -1114,6 +1114,7 @@ pub fn step<const D: usize, K: Kernel>(
     prime: bool,
 ) -> StepReport {
     let spec = &s.params.solver.dfsph;
+    let tolerance = s.params.density_tolerance();
     let dp = s.params.particle_spacing;
     let (kernel, grid, bound, fluid) = (&s.kernel, &s.grid, &s.bound, &mut s.fluid);
     let mut ranks = s.processes.ranks::<D>();
@@ -1221,14 +1222,14 @@ pub fn step<const D: usize, K: Kernel>(
             c,
             Mode::Density,
             dtf,
-            spec.max_density_error,
+            tolerance,
             (spec.min_iterations, spec.max_iterations),
             (&start, 1.0),
             ranks.as_deref_mut(),
         );
         report.density_iterations += it;
         report.density_error = err;
-        report.converged = err <= spec.max_density_error;
+        report.converged = err <= tolerance;
         report.totals.force = add(report.totals.force, t.force);
         report.totals.moment = add(report.totals.moment, t.moment);
         if control {
