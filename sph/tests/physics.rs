@@ -515,10 +515,10 @@ fn dfsph(mut p: SimParams) -> SimParams {
     p
 }
 
-/// The pressure solver reached its tolerance on every step.
+/// The pressure solver reached the tolerance it holds for the liquid on every step.
 fn assert_converged(sim: &dyn Solver) {
     let s = sim.stats();
-    let tol = sim.params().solver.dfsph.max_density_error;
+    let tol = sim.params().density_tolerance();
     assert_eq!(s.unconverged_steps, 0, "steps above the density tolerance");
     assert!(
         s.max_density_error <= tol,
