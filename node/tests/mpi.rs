@@ -229,7 +229,8 @@ fn incompressible_scheme_on_two_and_three_ranks_equals_the_serial_run() {
 }
 
 /// A failure on the ranks (here the time step collapsing at once) stops every rank; rank 0 reports it
-/// once and finishes the outputs. Too many ranks for the tank is refused with the most it takes.
+/// once and finishes the outputs. Too many ranks for the tank is refused with the most it takes, and the
+/// mDBC walls, which run in one process, by name.
 #[test]
 fn a_failure_stops_all_ranks_and_is_reported_once() {
     let dir = tmp("fail");
@@ -282,6 +283,30 @@ fn a_failure_stops_all_ranks_and_is_reported_once() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert!(err.contains("run on at most 7 ranks"), "{err}");
+
+    // The mDBC walls read the liquid at their images, which a rank's halo does not hold: refused by name.
+    let o = run_by(
+        mpirun(2),
+        &dir.join("mdbc"),
+        &[
+            "--duration",
+            "0.1",
+            "--set",
+            "dimension=2",
+            "--set",
+            "particle_spacing=0.02",
+            "--set",
+            "solver.scheme=wcsph",
+            "--set",
+            "solver.boundary.method=mdbc",
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("solver.boundary.method: mdbc") && err.contains("`dynamic` or `mirror`"),
+        "{err}"
+    );
 }
 
 /// A damaged box (the paper's case A at twice the size, dp = 5 mm) floating across the cut between two

@@ -55,7 +55,42 @@ pub fn fluid_lattice<const D: usize>(p: &SimParams) -> (Vec<[f64; D]>, f64) {
 }
 
 /// `layers` of lattice points outside the tank's inner faces, corners included, and the volume of each.
-pub fn wall_lattice<const D: usize>(p: &SimParams, layers: u32) -> (Vec<[f64; D]>, f64) {
+/// With `refine` > 1 each point is split into `refine`^(D−1) points along the face it lies beyond (a point
+/// beyond a face keeps its layer, the continuation of the liquid's lattice normal to the face, and is
+/// spread over its cell's extent along the face; by an edge or a corner along the first axes): the same wall,
+/// smoother to a liquid sliding along it.
+pub fn wall_lattice<const D: usize>(
+    p: &SimParams,
+    layers: u32,
+    refine: usize,
+) -> (Vec<[f64; D]>, f64) {
+    let (points, volume) = wall_lattice_points::<D>(p, layers);
+    if refine <= 1 {
+        return (points, volume);
+    }
+    let tank = TankBox::<D>::new(p);
+    let spacing = wall_spacing::<D>(p);
+    let mut out = Vec::with_capacity(points.len() * refine.pow(D as u32 - 1));
+    for x in points {
+        // The axes to split along: those the point lies within, then the first others.
+        let within = (0..D).filter(|&k| x[k] > tank.lo[k] && x[k] < tank.hi[k]);
+        let beyond = (0..D).filter(|&k| !(x[k] > tank.lo[k] && x[k] < tank.hi[k]));
+        let axes: Vec<usize> = within.chain(beyond).take(D - 1).collect();
+        for i in 0..refine.pow(axes.len() as u32) {
+            let mut y = x;
+            let mut rest = i;
+            for &k in &axes {
+                let j = rest % refine;
+                rest /= refine;
+                y[k] += ((j as f64 + 0.5) / refine as f64 - 0.5) * spacing[k];
+            }
+            out.push(y);
+        }
+    }
+    (out, volume / refine.pow(D as u32 - 1) as f64)
+}
+
+fn wall_lattice_points<const D: usize>(p: &SimParams, layers: u32) -> (Vec<[f64; D]>, f64) {
     let dp = p.particle_spacing;
     let tank = TankBox::<D>::new(p);
     let ax: Vec<(usize, f64)> = (0..D).map(|k| axis(tank.hi[k] - tank.lo[k], dp)).collect();
@@ -172,11 +207,39 @@ mod tests {
     #[test]
     fn walls_surround_the_tank() {
         let p = params(2);
-        let (w, _) = wall_lattice::<2>(&p, 3);
+        let (w, _) = wall_lattice::<2>(&p, 3, 1);
         // (40 + 6) × (30 + 6) − 40 × 30
         assert_eq!(w.len(), 46 * 36 - 40 * 30);
         let b = TankBox::<2>::new(&p);
         assert!(w.iter().all(|x| !b.contains(*x)));
+        // Refined: each point split in two along its face, the same wall (volume, layers, thickness).
+        let (w2, v2) = wall_lattice::<2>(&p, 3, 2);
+        let (_, v1) = wall_lattice::<2>(&p, 3, 1);
+        assert_eq!(w2.len(), 2 * w.len());
+        assert!((w2.len() as f64 * v2 - w.len() as f64 * v1).abs() < 1e-12);
+        assert!(w2.iter().all(|x| !b.contains(*x)));
+        let dp = p.particle_spacing;
+        // Below the floor: the layers of the liquid's lattice continued, two points a cell along x.
+        let floor: Vec<&[f64; 2]> = w2
+            .iter()
+            .filter(|x| x[0].abs() < 0.2 && x[1] < 0.0)
+            .collect();
+        assert!(floor.iter().all(|x| {
+            let layer = -x[1] / dp - 0.5;
+            (layer - layer.round()).abs() < 1e-9
+        }));
+        // 20 cells of the first layer, two points each.
+        assert_eq!(floor.iter().filter(|x| x[1] > -dp).count(), 40);
+        // Beside the end walls: the same along z.
+        let side: Vec<&[f64; 2]> = w2
+            .iter()
+            .filter(|x| x[0] < -0.4 && x[1] > 0.0 && x[1] < 0.3)
+            .collect();
+        assert_eq!(side.len(), 3 * 2 * 15);
+        assert!(side.iter().all(|x| {
+            let layer = (-0.4 - x[0]) / dp - 0.5;
+            (layer - layer.round()).abs() < 1e-9
+        }));
     }
 
     #[test]

@@ -159,6 +159,56 @@ fn tank_at_rest_is_hydrostatic_with_mirror_boundaries() {
     check_hydrostatics(p, 1.0);
 }
 
+#[test]
+fn tank_at_rest_is_hydrostatic_with_mdbc_walls() {
+    let mut p = tank2d(0.8, 0.6, 0.39, 0.02);
+    p.solver.boundary.method = BoundaryMethod::Mdbc;
+    p.probes = vec![
+        probe("wall", -0.376),
+        probe("mid", 0.0),
+        probe("p350", -0.05),
+    ];
+    p.pressure_sensors = sensors();
+    check_hydrostatics(p, 1.0);
+}
+
+/// Mean distance (in spacings) of the liquid's outermost row from the floor and of its outermost columns
+/// from the end walls, over the particles within `band` spacings of each.
+fn wall_gaps(sim: &dyn Solver, band: f64) -> [f64; 3] {
+    let p = sim.params();
+    let dp = p.particle_spacing;
+    let (lo, hi) = p.tank.inside();
+    let x = sim.fluid_positions();
+    let gap = |d: &dyn Fn(&[f64; 3]) -> f64| {
+        let near: Vec<f64> = x.iter().map(d).filter(|&g| g < band * dp).collect();
+        near.iter().sum::<f64>() / near.len() as f64 / dp
+    };
+    [
+        gap(&|x| x[2] - lo[2]),
+        gap(&|x| x[0] - lo[0]),
+        gap(&|x| hi[0] - x[0]),
+    ]
+}
+
+#[test]
+fn mdbc_walls_hold_the_liquid_at_rest_half_a_spacing_off_their_faces() {
+    // A liquid particle stands for the cell around it: at rest its centre is half a spacing from a wall face.
+    // The walls' layers continue the liquid's lattice normal to each face and carry the pressure extrapolated
+    // from the liquid (with the layers themselves at half the spacing, the liquid's bottom row settled 0.32
+    // spacings above the floor).
+    let mut p = tank2d(0.4, 0.6, 0.39, 0.01);
+    p.solver.boundary.method = BoundaryMethod::Mdbc;
+    p.probes = vec![];
+    let mut sim = sph::build(p).unwrap();
+    sim.advance_to(&AtRest, 0.5).unwrap();
+    let g = wall_gaps(sim.as_ref(), 1.0);
+    eprintln!(
+        "the outermost row {:.3} dp above the floor, columns {:.3} and {:.3} dp off the end walls",
+        g[0], g[1], g[2]
+    );
+    assert!(g.iter().all(|g| (g - 0.5).abs() < 0.05), "{g:?}");
+}
+
 /// A small 3D tank with the Wendland kernel, probes in a corner and the middle, a wall sensor 2.5 dp up.
 fn tank3d_wendland() -> SimParams {
     let mut p = tank2d(0.4, 0.3, 0.15, 0.02);
@@ -495,6 +545,7 @@ fn one_thread_and_two_threads_give_identical_results() {
     for (scheme, method) in [
         (Scheme::Wcsph, BoundaryMethod::Dynamic),
         (Scheme::Wcsph, BoundaryMethod::Mirror),
+        (Scheme::Wcsph, BoundaryMethod::Mdbc),
         (Scheme::Dfsph, BoundaryMethod::Dynamic),
     ] {
         let mut q = p.clone();

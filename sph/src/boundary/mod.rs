@@ -2,4 +2,5 @@
 //! loops treat alike; they differ in where the particles come from and how their density is found.
 
 pub mod dynamic;
+pub mod mdbc;
 pub mod mirror;

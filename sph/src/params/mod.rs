@@ -174,6 +174,17 @@ pub enum BoundaryMethod {
     /// Mirror ("dynamic ghost") particles of the fluid near each wall, with opposite normal velocity and the
     /// paper's anti-penetration restraint.
     Mirror,
+    /// Modified dynamic boundary conditions (English et al. 2022), `wcsph` only: the tank's wall layers at
+    /// half the particle spacing, each wall particle's density extrapolated from the liquid at its mirror
+    /// image across the wall face; the particles of bodies and obstacles keep the dynamic walls' continuity.
+    Mdbc,
+}
+
+impl BoundaryMethod {
+    /// Whether the walls are particles fixed to the tank (`dynamic`, `mdbc`), not ghosts of the liquid.
+    pub fn has_wall_particles(self) -> bool {
+        matches!(self, Self::Dynamic | Self::Mdbc)
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -34,10 +34,10 @@ impl SimParams {
         let Some(first) = self.obstacles.first() else {
             return Ok(());
         };
-        if self.solver.boundary.method != BoundaryMethod::Dynamic {
+        if !self.solver.boundary.method.has_wall_particles() {
             return Err(err(
                 &format!("obstacles.{}", first.name),
-                "obstacles are made of wall particles: set solver.boundary.method: dynamic",
+                "obstacles are made of wall particles: set solver.boundary.method: dynamic (or mdbc with wcsph)",
             ));
         }
         let support = 2.0 * self.h();
@@ -109,10 +109,10 @@ impl SimParams {
         if s.scheme == Scheme::Wcsph && s.integrator != Integrator::Symplectic {
             return Err(err(&field, "floating bodies and wave makers move with the liquid's symplectic steps: set solver.integrator: symplectic (or solver.scheme: dfsph)"));
         }
-        if s.boundary.method != BoundaryMethod::Dynamic {
+        if !s.boundary.method.has_wall_particles() {
             return Err(err(
                 &field,
-                "floating bodies and wave makers are made of wall particles: set solver.boundary.method: dynamic",
+                "floating bodies and wave makers are made of wall particles: set solver.boundary.method: dynamic (or mdbc with wcsph)",
             ));
         }
         let support = 2.0 * self.h();
@@ -152,7 +152,7 @@ impl SimParams {
         {
             return Err(err(
                 "solver.boundary.method",
-                "the dfsph scheme uses the wall particle layers (`dynamic`); `mirror` is for wcsph",
+                "the dfsph scheme uses the wall particle layers (`dynamic`); `mirror` and `mdbc` are for wcsph",
             ));
         }
         // The dfsph settings are checked whichever the scheme: a case run with wcsph and switched to dfsph

@@ -105,11 +105,17 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let mut fluid = Fluid::new(&points, hydro);
         let m_fluid = rho0 * volume;
 
-        let (mut wall_pts, wall_volume) = wall_lattice::<D>(&params, layers);
+        let refine = match params.solver.boundary.method {
+            BoundaryMethod::Mdbc => crate::boundary::mdbc::REFINE,
+            BoundaryMethod::Dynamic | BoundaryMethod::Mirror => 1,
+        };
+        let (mut wall_pts, wall_volume) = wall_lattice::<D>(&params, layers, refine);
         wall_pts.extend(crate::tank::obstacle_lattice::<D>(&params));
         let mut scratch = SortScratch::default();
         let mut bound = match params.solver.boundary.method {
-            BoundaryMethod::Dynamic => dynamic::build(&wall_pts, hydro, &eos),
+            BoundaryMethod::Dynamic | BoundaryMethod::Mdbc => {
+                dynamic::build(&wall_pts, hydro, &eos)
+            }
             BoundaryMethod::Mirror => Boundary::default(),
         };
         for (b, pts) in body_points.iter().enumerate() {
@@ -128,7 +134,7 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
             });
         }
         bodies.reindex(&bound);
-        let (shell_pts, shell_volume) = wall_lattice::<D>(&params, shell_layers);
+        let (shell_pts, shell_volume) = wall_lattice::<D>(&params, shell_layers, 1);
         let mut shell = Shell {
             points: dynamic::build(&shell_pts, |_| rho0, &eos),
             volume: shell_volume as f32,
@@ -152,12 +158,17 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         };
         let processes = match comm.filter(|c| c.size() > 1) {
             None => Processes::One,
+            Some(_) if params.solver.boundary.method == BoundaryMethod::Mdbc => {
+                return Err(SimError::Decomposition(
+                    "solver.boundary.method: mdbc runs in one process; across MPI ranks use `dynamic` or `mirror`".into(),
+                ));
+            }
             Some(c) => {
                 // Mirror ghosts are rebuilt from where particles are mid-step, which may be a column
                 // beyond where they were sorted: one more halo column brings their sources.
                 let halo = match params.solver.boundary.method {
                     BoundaryMethod::Mirror => crate::neighbours::REACH + 1,
-                    BoundaryMethod::Dynamic => crate::neighbours::REACH,
+                    BoundaryMethod::Dynamic | BoundaryMethod::Mdbc => crate::neighbours::REACH,
                 };
                 Processes::Many(
                     Domain::split(c, &grid, &mut fluid, halo).map_err(SimError::Decomposition)?,

@@ -5,7 +5,6 @@ use super::Simulation;
 use crate::domain::Domain;
 use crate::kernel::Kernel;
 use crate::observe::snapshot::Snapshot;
-use crate::params::BoundaryMethod;
 use crate::particles::Fluid;
 use crate::vector::to3;
 
@@ -114,7 +113,13 @@ impl<const D: usize, K: Kernel> Simulation<D, K> {
         let b = &self.state.bound;
         // Wall layers carry their owner's density; mirror ghosts differ from rank to rank: rank 0's are
         // written.
-        let walls = self.state.params.solver.boundary.method == BoundaryMethod::Dynamic;
+        let walls = self
+            .state
+            .params
+            .solver
+            .boundary
+            .method
+            .has_wall_particles();
         let mut local = Vec::with_capacity(s.fluid * 9 + 1);
         local.push(s.fluid as f64);
         for i in 0..s.fluid {

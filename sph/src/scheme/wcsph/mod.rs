@@ -18,7 +18,7 @@ pub mod rates;
 pub use rates::Coefficients;
 
 use super::{coupling, landing, PressureScheme, State};
-use crate::boundary::{dynamic, mirror};
+use crate::boundary::{dynamic, mdbc, mirror};
 use crate::domain::Op;
 use crate::error::SimError;
 use crate::integrate;
@@ -51,7 +51,7 @@ impl<const D: usize, K: Kernel> PressureScheme<D, K> for Wcsph<D> {
         if t + dt > end + 1e-12 {
             return Err(SimError::MotionEnded { time: t + dt, end });
         }
-        let walls = s.params.solver.boundary.method == BoundaryMethod::Dynamic;
+        let walls = s.params.solver.boundary.method.has_wall_particles();
         match s.params.solver.integrator {
             Integrator::Symplectic => {
                 integrate::symplectic_predict(&mut s.fluid, walls.then_some(&mut s.bound), dt);
@@ -129,7 +129,7 @@ impl<const D: usize> Wcsph<D> {
         sort: bool,
     ) -> Result<(), SimError> {
         let frame = s.frame(motion, t);
-        let walls = s.params.solver.boundary.method == BoundaryMethod::Dynamic;
+        let walls = s.params.solver.boundary.method.has_wall_particles();
         if sort {
             s.rebin(t, walls)?;
         } else if let Some(dom) = s.processes.domain_mut() {
@@ -143,6 +143,13 @@ impl<const D: usize> Wcsph<D> {
         }
         match s.params.solver.boundary.method {
             BoundaryMethod::Dynamic => dynamic::refresh(&mut s.bound, &eos),
+            BoundaryMethod::Mdbc => {
+                // Bodies' and obstacles' particles from their continuity density, the tank's walls from
+                // the liquid.
+                dynamic::refresh(&mut s.bound, &eos);
+                let m = s.coef.m_fluid;
+                mdbc::refresh(&s.kernel, &s.grid, &s.fluid, &s.tank, m, &eos, &mut s.bound);
+            }
             BoundaryMethod::Mirror => {
                 let g: [f64; D] = from3(frame.g.map(|v| v as f64));
                 let support = s.kernel.support() as f64;
