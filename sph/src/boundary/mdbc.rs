@@ -11,11 +11,12 @@
 //! the liquid around g is too sparse for that system (a wall above the liquid, a splash), Shepard's
 //! interpolation, and ρ0 where there is none; never below ρ0, so walls do not pull.
 //!
-//! The walls then hold the hydrostatic pressure of the liquid at their own depth, so the liquid stands half a
-//! spacing from the faces as it should (the continuity density of the plain dynamic walls holds it about a
-//! spacing off where the pressure is high). The layers are at half the particle spacing ([`REFINE`]): a liquid
-//! sliding along a lattice of wall particles one spacing apart feels its bumps, which damps sloshing (see the
-//! manual's decisions).
+//! The walls then hold the pressure of the liquid at their own depth, and the liquid's distribution along them
+//! is right (with the continuity density of the plain dynamic walls the liquid along a deep wall thins, and a
+//! tilted tank's moment comes out low). Each point of the wall lattice is split along its face into
+//! [`REFINE`]^(D−1) ([`crate::tank::wall_lattice`]): a liquid sliding along wall particles one spacing apart
+//! feels their bumps, which damp sloshing; the layers stay where the liquid's lattice continues, so the
+//! liquid at rest stands half a spacing from the faces (see the manual's decisions).
 
 use crate::eos::Tait;
 use crate::kernel::Kernel;
@@ -24,7 +25,7 @@ use crate::particles::{Boundary, Fluid, NOT_BODY};
 use crate::tank::TankBox;
 use rayon::prelude::*;
 
-/// The tank's wall lattice is this many times finer than the liquid's along each axis.
+/// Each point of the tank's wall lattice is split this many times along each axis of its face.
 pub const REFINE: usize = 2;
 
 /// Σ_b V_b W_gb below which the liquid around a ghost node is too sparse for the gradient: Shepard's

@@ -174,9 +174,10 @@ pub enum BoundaryMethod {
     /// Mirror ("dynamic ghost") particles of the fluid near each wall, with opposite normal velocity and the
     /// paper's anti-penetration restraint.
     Mirror,
-    /// Modified dynamic boundary conditions (English et al. 2022), `wcsph` only: the tank's wall layers at
-    /// half the particle spacing, each wall particle's density extrapolated from the liquid at its mirror
-    /// image across the wall face; the particles of bodies and obstacles keep the dynamic walls' continuity.
+    /// Modified dynamic boundary conditions (English et al. 2022), `wcsph` only, one process: the tank's wall
+    /// layers with each point split in two along its face (four in 3D), each wall particle's density
+    /// extrapolated from the liquid at its mirror image across the wall face; the particles of bodies and
+    /// obstacles keep the dynamic walls' continuity.
     Mdbc,
 }
 
