@@ -71,14 +71,18 @@ fn steps_allocate_nothing_once_the_buffers_have_settled() {
         ramp: 0.5,
     };
     // In 3D too: more chunks, each meeting runs of cells of its own (and the incompressible scheme keeps
-    // its 3D neighbour lists and velocities in four lanes).
-    for (scheme, dimension) in [
-        (Scheme::Wcsph, 2),
-        (Scheme::Wcsph, 3),
-        (Scheme::Dfsph, 2),
-        (Scheme::Dfsph, 3),
+    // its 3D neighbour lists and velocities in four lanes); and the mDBC walls, read from the liquid at
+    // every evaluation.
+    for (scheme, walls, dimension) in [
+        (Scheme::Wcsph, BoundaryMethod::Dynamic, 2),
+        (Scheme::Wcsph, BoundaryMethod::Dynamic, 3),
+        (Scheme::Wcsph, BoundaryMethod::Mdbc, 2),
+        (Scheme::Dfsph, BoundaryMethod::Dynamic, 2),
+        (Scheme::Dfsph, BoundaryMethod::Dynamic, 3),
     ] {
-        let mut sim = sph::build(seed_tank(scheme, dimension)).unwrap();
+        let mut p = seed_tank(scheme, dimension);
+        p.solver.boundary.method = walls;
+        let mut sim = sph::build(p).unwrap();
         // Buffers grow to the largest neighbourhood seen: let the flow get going first.
         for _ in 0..300 {
             sim.step(&motion).unwrap();
@@ -96,7 +100,7 @@ fn steps_allocate_nothing_once_the_buffers_have_settled() {
                 }
                 allocations += ALLOCATIONS.load(Ordering::Relaxed) - before;
                 eprintln!(
-                    "{scheme:?} {dimension}D: {allocations} allocations in {} steps, t = {:.3} s",
+                    "{scheme:?} {walls:?} {dimension}D: {allocations} allocations in {} steps, t = {:.3} s",
                     (window + 1) * steps,
                     sim.time()
                 );
@@ -104,7 +108,7 @@ fn steps_allocate_nothing_once_the_buffers_have_settled() {
         });
         assert_eq!(
             allocations, 0,
-            "{scheme:?} {dimension}D: {allocations} allocations"
+            "{scheme:?} {walls:?} {dimension}D: {allocations} allocations"
         );
     }
 }

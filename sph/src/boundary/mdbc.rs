@@ -44,35 +44,36 @@ pub fn refresh<const D: usize, K: Kernel>(
     b: &mut Boundary<D>,
 ) {
     let rho0 = eos.rho0 as f64;
-    let x = &b.x;
-    let tag = &b.tag;
-    let rho: Vec<Option<f64>> = (0..b.len())
+    let Boundary {
+        x,
+        tag,
+        rho,
+        r,
+        p,
+        pr2,
+        ..
+    } = b;
+    (rho, r, p, pr2)
         .into_par_iter()
-        .map(|w| {
+        .enumerate()
+        .for_each(|(w, (rho, r, p, pr2))| {
             let xw: [f64; D] = std::array::from_fn(|k| x[k][w] as f64);
             if tag[w] != NOT_BODY || tank.contains(xw) {
-                return None;
+                return;
             }
             let xg = ghost(tank, xw);
-            let rho = match interpolate(kernel, grid, fluid, m_fluid as f64, xg) {
+            let extrapolated = match interpolate(kernel, grid, fluid, m_fluid as f64, xg) {
                 Interpolated::Gradient(r, g) => {
                     r + (0..D).map(|k| g[k] * (xw[k] - xg[k])).sum::<f64>()
                 }
                 Interpolated::Shepard(r) => r,
                 Interpolated::Empty => rho0,
             };
-            Some(rho.max(rho0))
-        })
-        .collect();
-    for (w, r) in rho.into_iter().enumerate() {
-        if let Some(r) = r {
-            b.rho[w] = r;
-            let r = r as f32;
-            b.r[w] = r;
-            b.p[w] = eos.pressure(r);
-            b.pr2[w] = b.p[w] / (r * r);
-        }
-    }
+            *rho = extrapolated.max(rho0);
+            *r = *rho as f32;
+            *p = eos.pressure(*r);
+            *pr2 = *p / (*r * *r);
+        });
 }
 
 /// The mirror image of `xw` (outside the tank) across every face it lies beyond.
