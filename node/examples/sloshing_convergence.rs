@@ -11,7 +11,12 @@
 //! cargo run --release -p slosh-node --example sloshing_convergence -- --fine    # adds 3D at 10 mm, 2D wcsph at 5 mm
 //! cargo run --release -p slosh-node --example sloshing_convergence -- --quick   # 2D at 40 and 20 mm, printed only
 //! cargo run --release -p slosh-node --example sloshing_convergence -- --redraw  # table and figure from the CSV
+//! cargo run --release -p slosh-node --example sloshing_convergence -- --only 3:0.01  # re-measure some rows
 //! ```
+//!
+//! `--only DIM:DP` (repeatable) runs only the cases of that dimension and spacing (from the `--fine` list) and
+//! merges their rows into the CSV, the table and the figure, replacing rows of the same setting, dimension,
+//! fill and spacing.
 //!
 //! `--png FILE` also draws the figure as a PNG (to look at without an SVG viewer).
 use plotters::prelude::*;
@@ -25,7 +30,18 @@ const FILLS: [f64; 2] = [0.19, 0.39];
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
-    let fine = args.iter().any(|a| a == "--fine");
+    let only: Vec<(usize, f64)> = args
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| *a == "--only")
+        .map(|(i, _)| {
+            let v = args.get(i + 1).map(String::as_str).unwrap_or("");
+            v.split_once(':')
+                .and_then(|(d, dp)| Some((d.parse().ok()?, dp.parse().ok()?)))
+                .unwrap_or_else(|| panic!("--only DIM:DP (e.g. 3:0.01), not `{v}`"))
+        })
+        .collect();
+    let fine = args.iter().any(|a| a == "--fine") || !only.is_empty();
     let png = args
         .iter()
         .position(|a| a == "--png")
@@ -55,6 +71,9 @@ fn main() {
                     cases.push((3, 0.01));
                 }
             }
+        }
+        if !only.is_empty() {
+            cases.retain(|c| only.contains(c));
         }
         for &(dim, dp) in &cases {
             for fill in FILLS {
@@ -88,9 +107,36 @@ fn main() {
     }
     let machine = slosh_node::manual::machine();
     let threads = rayon::current_num_threads();
-    let heading = format!("{machine} ({threads} threads)");
+    let mut heading = format!("{machine} ({threads} threads)");
+    if !only.is_empty() {
+        let text = std::fs::read_to_string(&data).expect("docs/src/validation/convergence.csv");
+        let (old, old_heading) = read_csv(&text).expect("the CSV this command writes");
+        rows = merge(old, rows);
+        if old_heading != heading {
+            heading = format!("{old_heading}; the rows of `--only` on {heading}");
+        }
+    }
     std::fs::write(&data, csv(&heading, &rows)).unwrap();
     write(&root, &rows, &heading, png);
+}
+
+/// `old` with `new` in place of its rows of the same setting, dimension, fill and spacing, in the order the
+/// whole command writes them (by setting, dimension, spacing from coarse to fine, fill).
+fn merge(old: Vec<Row>, new: Vec<Row>) -> Vec<Row> {
+    let key = |r: &Row| (r.setting.clone(), r.dimension, r.fill, r.spacing);
+    let mut rows: Vec<Row> = old
+        .into_iter()
+        .filter(|r| !new.iter().any(|n| key(n) == key(r)))
+        .collect();
+    rows.extend(new);
+    let setting = |r: &Row| SETTINGS.iter().position(|s| s.name == r.setting);
+    rows.sort_by(|a, b| {
+        (setting(a), a.dimension)
+            .cmp(&(setting(b), b.dimension))
+            .then(b.spacing.total_cmp(&a.spacing))
+            .then(a.fill.total_cmp(&b.fill))
+    });
+    rows
 }
 
 /// The manual's table and figure from `rows`.
