@@ -20,7 +20,7 @@
 //!
 //! `--png FILE` also draws the figure as a PNG (to look at without an SVG viewer).
 use plotters::prelude::*;
-use slosh_node::accuracy::{csv, read_csv, Row, SETTINGS};
+use slosh_node::accuracy::{csv, merge, read_csv, Row, SETTINGS};
 use slosh_node::plot::figure::{self, Figure, Panel, Series};
 use sph::sloshing::experiment::{free_decay, seed_tank};
 use std::path::Path;
@@ -118,25 +118,6 @@ fn main() {
     }
     std::fs::write(&data, csv(&heading, &rows)).unwrap();
     write(&root, &rows, &heading, png);
-}
-
-/// `old` with `new` in place of its rows of the same setting, dimension, fill and spacing, in the order the
-/// whole command writes them (by setting, dimension, spacing from coarse to fine, fill).
-fn merge(old: Vec<Row>, new: Vec<Row>) -> Vec<Row> {
-    let key = |r: &Row| (r.setting.clone(), r.dimension, r.fill, r.spacing);
-    let mut rows: Vec<Row> = old
-        .into_iter()
-        .filter(|r| !new.iter().any(|n| key(n) == key(r)))
-        .collect();
-    rows.extend(new);
-    let setting = |r: &Row| SETTINGS.iter().position(|s| s.name == r.setting);
-    rows.sort_by(|a, b| {
-        (setting(a), a.dimension)
-            .cmp(&(setting(b), b.dimension))
-            .then(b.spacing.total_cmp(&a.spacing))
-            .then(a.fill.total_cmp(&b.fill))
-    });
-    rows
 }
 
 /// The manual's table and figure from `rows`.

@@ -115,6 +115,25 @@ pub fn csv(heading: &str, rows: &[Row]) -> String {
     out
 }
 
+/// `old` with `new` in place of its rows of the same setting, dimension, fill and spacing, in the order the
+/// whole command writes them (by setting, dimension, spacing from coarse to fine, fill).
+pub fn merge(old: Vec<Row>, new: Vec<Row>) -> Vec<Row> {
+    let key = |r: &Row| (r.setting.clone(), r.dimension, r.fill, r.spacing);
+    let mut rows: Vec<Row> = old
+        .into_iter()
+        .filter(|r| !new.iter().any(|n| key(n) == key(r)))
+        .collect();
+    rows.extend(new);
+    let setting = |r: &Row| SETTINGS.iter().position(|s| s.name == r.setting);
+    rows.sort_by(|a, b| {
+        (setting(a), a.dimension)
+            .cmp(&(setting(b), b.dimension))
+            .then(b.spacing.total_cmp(&a.spacing))
+            .then(a.fill.total_cmp(&b.fill))
+    });
+    rows
+}
+
 /// The rows of a CSV that [`csv`] wrote, and its first line's machine.
 pub fn read_csv(text: &str) -> Result<(Vec<Row>, String), String> {
     let mut lines = text.lines();
@@ -244,6 +263,49 @@ mod tests {
 \"a, b\",2,0.19,0.005,1.001000,1.000000,0.001000,0.000600,0.000700,17.4,\n\
 \"a, b\",2,0.39,0.005,,,,,,,\"the run failed\"\n\
 \"a, b\",3,0.19,0.02,1.001000,1.000000,0.001000,0.020000,0.002000,22.6,\n";
+
+    #[test]
+    fn merged_rows_replace_their_namesakes_in_the_command_s_order() {
+        let row = |setting: &str, dimension, fill, spacing, t: f64| Row {
+            setting: setting.to_string(),
+            dimension,
+            fill,
+            spacing,
+            result: Ok([t, 1.0, 0.01, 0.001, 1.0]),
+        };
+        let old = vec![
+            row(SHIPPED_WCSPH, 2, 0.19, 0.02, 0.9),
+            row(SHIPPED_DFSPH, 3, 0.19, 0.02, 0.9),
+            row(SHIPPED_DFSPH, 2, 0.19, 0.04, 0.9),
+            row(SHIPPED_DFSPH, 2, 0.39, 0.04, 0.9),
+        ];
+        let new = vec![
+            row(SHIPPED_DFSPH, 3, 0.39, 0.01, 1.1),
+            row(SHIPPED_DFSPH, 3, 0.19, 0.02, 1.2),
+            row(SHIPPED_DFSPH, 3, 0.19, 0.01, 1.1),
+        ];
+        let merged = merge(old, new);
+        let keys: Vec<(&str, usize, f64, f64)> = merged
+            .iter()
+            .map(|r| (r.setting.as_str(), r.dimension, r.fill, r.spacing))
+            .collect();
+        assert_eq!(
+            keys,
+            [
+                (SHIPPED_DFSPH, 2, 0.19, 0.04),
+                (SHIPPED_DFSPH, 2, 0.39, 0.04),
+                (SHIPPED_DFSPH, 3, 0.19, 0.02),
+                (SHIPPED_DFSPH, 3, 0.19, 0.01),
+                (SHIPPED_DFSPH, 3, 0.39, 0.01),
+                (SHIPPED_WCSPH, 2, 0.19, 0.02),
+            ]
+        );
+        // The new row replaced the old one of the same setting, dimension, fill and spacing.
+        assert_eq!(merged[2].result.as_ref().unwrap()[0], 1.2);
+        // The built-in table is in that order already.
+        let (table, _) = read_csv(TABLE).unwrap();
+        assert_eq!(merge(table.clone(), vec![]), table);
+    }
 
     #[test]
     fn the_table_is_read_and_the_coarsest_passing_depth_found() {
