@@ -1,10 +1,11 @@
-//! The discharge coefficient of a slot against its width in particle spacings, with both schemes
-//! (`sph::flooding::slot_case`: a reservoir emptying through a slot in its wall into a dry compartment):
-//! prints the manual's table (guide/flooding.md).
+//! The discharge coefficient of a slot against its width in particle spacings, with both schemes and both
+//! kinds of wall (`sph::flooding::slot_case`: a reservoir emptying through a slot in its wall into a dry
+//! compartment; the wall fixed obstacles, or a fixed body's side): prints the manual's table
+//! (guide/flooding.md).
 //!
 //!     cargo run --release -p slosh-sph --example discharge_coefficient [-- --dp 0.005]
 
-use sph::flooding::{slot_case, slot_discharge};
+use sph::flooding::{slot_case, slot_discharge, SlotWall};
 use sph::params::Scheme;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -14,11 +15,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .position(|a| a == "--dp")
         .and_then(|i| args.get(i + 1))
         .map_or(Ok(0.005), |s| s.parse::<f64>())?;
-    println!("| scheme | slot, spacings | slot, mm | C_d per window (0.1 s from 0.2 s) | mean | head, m |");
-    println!("|---|---|---|---|---|---|");
-    for scheme in [Scheme::Wcsph, Scheme::Dfsph] {
+    println!(
+        "| scheme | wall | slot, spacings | slot, mm | C_d per window (0.1 s from 0.2 s) | mean | head, m |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    let runs = [SlotWall::Obstacles, SlotWall::Body]
+        .into_iter()
+        .flat_map(|wall| [Scheme::Wcsph, Scheme::Dfsph].map(|scheme| (wall, scheme)));
+    for (wall, scheme) in runs {
         for opening in [4.0, 8.0, 12.0, 16.0] {
-            let d = slot_discharge(slot_case(scheme, opening, dp), 0.6, 0.02, (0.2, 0.1))?;
+            let p = slot_case(scheme, wall, opening, dp);
+            let d = slot_discharge(p, 0.6, 0.02, (0.2, 0.1))?;
             let cds: Vec<f64> = d.windows.iter().map(|w| w.cd).collect();
             let mean = cds.iter().sum::<f64>() / cds.len().max(1) as f64;
             let list: Vec<String> = cds.iter().map(|c| format!("{c:.2}")).collect();
@@ -27,10 +34,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 return Err("no window: the run is shorter than its settling time".into());
             };
             println!(
-                "| {} | {opening} | {:.0} | {} | {mean:.2} | {:.3}–{:.3} |",
+                "| {} | {} | {opening} | {:.0} | {} | {mean:.2} | {:.3}–{:.3} |",
                 match scheme {
                     Scheme::Wcsph => "wcsph",
                     Scheme::Dfsph => "dfsph",
+                },
+                match wall {
+                    SlotWall::Obstacles => "obstacles",
+                    SlotWall::Body => "body",
                 },
                 d.width * 1000.0,
                 list.join(", "),

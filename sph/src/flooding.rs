@@ -7,7 +7,9 @@
 //!   reservoir 0.5 m long filled 0.5 m deep empties through a slot in its wall (3 spacings thick) into a dry
 //!   compartment 0.685 m long; the slot's centre 0.2 m + half its width above the floor. The head is read by a
 //!   probe 0.35 m from the wall, the flow from the volume left behind the wall; the reservoir is large enough
-//!   that the head falls by a fifth over the run and the tail water stays below the slot.
+//!   that the head falls by a fifth over the run and the tail water stays below the slot. The wall is made
+//!   of fixed obstacles ([`SlotWall::Obstacles`]) or is the side of a fixed hollow body whose inside is the
+//!   compartment ([`SlotWall::Body`]: the same slot as a damaged body's opening).
 //! - [`case`] / [`discharge`]: a damaged body filling. A 2D basin 0.8 m long filled 0.25 m deep holds a fixed
 //!   closed box 0.2 × 0.2 m (walls 15 mm) floating 0.15 m deep, with a slot of `opening` spacings in its
 //!   bottom; the basin's level is read by a probe 0.3 m from the box, the level inside from the flooded
@@ -145,9 +147,20 @@ pub const FILL: f64 = 0.5;
 pub const SLOT_WALL_X: f64 = -0.1;
 pub const SLOT_SILL: f64 = 0.2;
 
-/// The reservoir and the dry compartment, the slot `opening` spacings wide in a wall 3 spacings thick, at
-/// spacing `dp`, with `scheme`.
-pub fn slot_case(scheme: Scheme, opening: f64, dp: f64) -> SimParams {
+/// What the slot experiment's wall is made of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SlotWall {
+    /// Two fixed obstacles, below and above the slot (the tank's own kind of wall).
+    Obstacles,
+    /// The −x side of a fixed hollow body (the compartment is its inside; a floating body's kind of wall,
+    /// the slot one of its openings). It stands on an obstacle three spacings high (as thick as the wall, so
+    /// no liquid sees through it) that seals the gap under it.
+    Body,
+}
+
+/// The reservoir and the dry compartment, the slot `opening` spacings wide in a wall 3 spacings thick made
+/// of `wall`, at spacing `dp`, with `scheme`.
+pub fn slot_case(scheme: Scheme, wall: SlotWall, opening: f64, dp: f64) -> SimParams {
     let tank = TankSpec {
         length: 1.2,
         breadth: 1.0,
@@ -156,14 +169,50 @@ pub fn slot_case(scheme: Scheme, opening: f64, dp: f64) -> SimParams {
     let mut p = SimParams::filled_tank(2, tank, FILL, dp);
     p.fill.length = RESERVOIR;
     p.solver.scheme = scheme;
-    let (thick, top) = (3.0 * dp, SLOT_SILL + opening * dp);
-    let x = SLOT_WALL_X + 0.5 * thick;
-    let wall = |name: &str, from: f64, to: f64| RegionSpec {
+    let (thick, width) = (3.0 * dp, opening * dp);
+    let region = |name: &str, x: [f64; 2], z: [f64; 2]| RegionSpec {
         name: name.into(),
-        centre: [x, 0.0, 0.5 * (from + to)],
-        size: [thick, 1.0, to - from],
+        centre: [0.5 * (x[0] + x[1]), 0.0, 0.5 * (z[0] + z[1])],
+        size: [x[1] - x[0], 1.0, z[1] - z[0]],
     };
-    p.obstacles = vec![wall("sill", 0.0, SLOT_SILL), wall("lintel", top, 0.65)];
+    let wall_x = [SLOT_WALL_X, SLOT_WALL_X + thick];
+    match wall {
+        SlotWall::Obstacles => {
+            p.obstacles = vec![
+                region("sill", wall_x, [0.0, SLOT_SILL]),
+                region("lintel", wall_x, [SLOT_SILL + width, 0.65]),
+            ];
+        }
+        SlotWall::Body => {
+            // The body from the wall to 3 spacings short of the tank's +x end, 0.65 m high.
+            let (x0, x1, z0, z1) = (SLOT_WALL_X, 0.6 - 3.0 * dp, thick, 0.66);
+            let length = x1 - x0;
+            p.obstacles = vec![region("seal", [x0, x1], [0.0, z0])];
+            p.bodies = vec![BodySpec {
+                name: "compartment".into(),
+                size: [length, 1.0, z1 - z0],
+                wall_thickness: thick,
+                position: [0.5 * (x0 + x1), 0.0, z0],
+                mass: 100.0,
+                inertia: [10.0; 3],
+                centre_of_gravity: [0.0, 0.0, 0.3],
+                velocity: [0.0; 3],
+                angular_velocity: [0.0; 3],
+                fixed: Dof::ALL.to_vec(),
+                openings: vec![RegionSpec {
+                    name: "slot".into(),
+                    centre: [
+                        -0.5 * length + 0.5 * thick,
+                        0.0,
+                        SLOT_SILL + 0.5 * width - z0,
+                    ],
+                    size: [2.0 * thick, 1.0, width],
+                }],
+                bulkheads: vec![],
+                springs: vec![],
+            }];
+        }
+    }
     p.probes = vec![ProbeSpec {
         name: "reservoir".into(),
         x: SLOT_WALL_X - 0.35,
@@ -191,8 +240,11 @@ pub fn slot_discharge(
     every: f64,
     (settle, window): (f64, f64),
 ) -> Result<SlotDischarge, SimError> {
-    let sill = params.obstacles[0].size[2];
-    let width = params.obstacles[1].centre[2] - 0.5 * params.obstacles[1].size[2] - sill;
+    let sill = SLOT_SILL;
+    let width = match params.bodies.first() {
+        Some(body) => body.openings[0].size[2],
+        None => params.obstacles[1].centre[2] - 0.5 * params.obstacles[1].size[2] - sill,
+    };
     let (g, cell) = (params.gravity, params.particle_spacing.powi(2));
     let mut sim = crate::build(params)?;
     let behind = |sim: &dyn Solver| {

@@ -1127,3 +1127,107 @@ fn wcsph_holds_a_tilted_tank_s_weight_through_the_centroid() {
         }
     }
 }
+
+/// The paper's flooding case A (`flooding_case_a`: a 2D damaged box 0.1 m square with 10 mm walls fills
+/// through a 20 mm hole in its bottom and sinks onto the basin's floor; dp 2.5 mm, 1 s) with both schemes:
+/// from 0.2 s on the flooded volumes within 10 % of each other (before, while the jet enters the dry box
+/// through a hole that WCSPH's walls narrow, `dfsph`'s runs 10–15 % ahead: a target, not asserted); at the end
+/// the box on the floor, its hollow full within 6 % (WCSPH's wall particles hold its liquid about 0.4 spacing
+/// off the walls, which leaves (1 − 0.8 dp / 80 mm)² = 0.95 of the hollow to its particles). Not an
+/// experiment: the seed paper's record of the case is lost; about three minutes, most of it WCSPH's.
+#[test]
+fn flooding_case_a_floods_alike_with_both_schemes() {
+    let started = std::time::Instant::now();
+    let spec = config::load("flooding_case_a", &[])
+        .unwrap()
+        .sim_params()
+        .unwrap()
+        .bodies[0]
+        .clone();
+    let hollow =
+        (spec.size[0] - 2.0 * spec.wall_thickness) * (spec.size[2] - 2.0 * spec.wall_thickness);
+    let dp = 0.0025;
+    let every = 0.05;
+    // Time, flooded volume (m² per metre), height of the centre of gravity.
+    let run = |scheme: &str| -> Vec<(f64, f64, f64)> {
+        let o = format!("solver.scheme={scheme}");
+        observe("flooding_case_a", &[&o], &sph::motion::AtRest, 1.0, every)
+            .iter()
+            .map(|o| (o.time, o.bodies[0].flooded_volume, o.bodies[0].position[2]))
+            .collect()
+    };
+    let (w, d) = (run("wcsph"), run("dfsph"));
+    assert_eq!(w.len(), d.len());
+    let mut r = Results::new(
+        "flooding_case_a_schemes",
+        "flooding.md",
+        "WCSPH and DFSPH, flooding case A, dp 2.5 mm, 0-1 s",
+        started,
+    );
+    let litres = |v: f64| format!("{:.2} l/m", 1000.0 * v);
+    for (a, b) in w.iter().zip(&d) {
+        let k = (a.0 / every).round() as usize;
+        if k == 0 || (k % 2 != 0 && k != 3) {
+            continue;
+        }
+        let ratio = b.1 / a.1 - 1.0;
+        let quantity = format!("flooded volume at {:.2} s, `dfsph` against `wcsph`", a.0);
+        let (sim, reference) = (litres(b.1), litres(a.1));
+        let bound = "± 10 % from 0.2 s";
+        if a.0 < 0.2 - 1e-9 {
+            r.target(&quantity, sim, reference, bound, ratio.abs() <= 0.1);
+        } else {
+            r.row(&quantity, sim, reference, bound, Some(ratio.abs() <= 0.1));
+        }
+    }
+    let worst = w
+        .iter()
+        .zip(&d)
+        .filter(|(a, _)| a.0 >= 0.2 - 1e-9)
+        .map(|(a, b)| b.1 / a.1 - 1.0)
+        .fold(0.0f64, |m, x| if x.abs() > m.abs() { x } else { m });
+    r.row(
+        "largest difference from 0.2 s (every 0.05 s)",
+        format!("{:+.1} %", 100.0 * worst),
+        "0".into(),
+        "± 10 %",
+        Some(worst.abs() <= 0.1),
+    );
+    for (label, s) in [("wcsph", &w), ("dfsph", &d)] {
+        let (_, v, z) = *s.last().unwrap();
+        r.row(
+            &format!("`{label}`: flooded volume at 1 s"),
+            litres(v),
+            format!("{} (the hollow)", litres(hollow)),
+            "± 6 %",
+            Some((v / hollow - 1.0).abs() <= 0.06),
+        );
+        // On the floor: the box's bottom within a spacing of it (contact holds it one spacing inside).
+        let bottom = z - spec.centre_of_gravity[2];
+        r.row(
+            &format!("`{label}`: the box's bottom above the floor at 1 s"),
+            format!("{:.1} mm", 1000.0 * bottom),
+            "0 (resting on the floor)".into(),
+            "below 1 spacing (2.5 mm)",
+            Some(bottom < dp),
+        );
+    }
+    let t: Vec<f64> = w.iter().map(|s| s.0).collect();
+    let vol = |s: &[(f64, f64, f64)]| s.iter().map(|s| 1000.0 * s.1).collect::<Vec<_>>();
+    figure(
+        "flooding_case_a_schemes",
+        "Flooding case A: the damaged box's flooded volume, both schemes (dp 2.5 mm)",
+        "flooded volume (l per metre)",
+        vec![
+            series("wcsph", &t, &vol(&w), false),
+            series("dfsph", &t, &vol(&d), false),
+            series(
+                "the hollow (full)",
+                &t,
+                &vec![1000.0 * hollow; t.len()],
+                true,
+            ),
+        ],
+    );
+    r.publish_and_check();
+}

@@ -92,8 +92,8 @@ pub struct DfsphSpec {
     pub target_iterations: u32,
     /// Share β of the hydrostatic pressure (per column of the liquid, below its highest particle) that the
     /// constant-density solve carries over whole from the last step; of the rest of the last pressure it
-    /// carries 0.6 (`sph::scheme::dfsph::warm_start::REST`). 0: half the whole last pressure (Bender & Koschier 2017), as
-    /// always with bodies (floating bodies, fixed or not, a wave maker) and with `smoothing_ratio` < 1.
+    /// carries 0.6 (`sph::scheme::dfsph::warm_start::REST`). 0: half the whole last pressure (Bender & Koschier
+    /// 2017), as always with `smoothing_ratio` < 1.
     pub hydrostatic_warm_start: f64,
     /// Correct the kernel gradients of the pressure passes (`sph::scheme::dfsph::gradient_correction`: each
     /// particle's gradients times the inverse of its Σ V (x_b − x_a) ⊗ ∇W, symmetrised over the pair), so
@@ -136,7 +136,7 @@ impl Default for DfsphSpec {
             max_divergence_error: 1.0e-3,
             relaxation: None,
             min_iterations: 2,
-            max_iterations: 100,
+            max_iterations: 200,
             divergence_solve: true,
             target_iterations: 20,
             hydrostatic_warm_start: 0.95,

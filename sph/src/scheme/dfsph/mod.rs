@@ -73,12 +73,6 @@ impl<const D: usize> Dfsph<D> {
         };
         let mut work = Workspace::default();
         work.correct_gradients(p.gradients_corrected());
-        if !s.bodies.is_empty() {
-            // Bodies start from rest with forces the liquid has not balanced yet (a hole, a kick): the
-            // steps start a tenth of their longest and grow as the solves allow.
-            work.start_at(0.1 * p.solver.dfsph.dt_max);
-            work.plain_warm_start();
-        }
         Self {
             coef,
             work,

@@ -116,9 +116,6 @@ pub struct Workspace<const D: usize> {
     /// Where the constant-density solve starts (per particle), and the columns that make it.
     start: Vec<f64>,
     columns: Columns,
-    /// Start the constant-density solve from half the last pressure, not from its hydrostatic part
-    /// ([`Workspace::plain_warm_start`]).
-    plain_warm_start: bool,
     /// Correct the kernel gradients (`gradient_correction`), and each particle's L = M⁻¹ when it does.
     corrected: bool,
     corr: Vec<Mat<D>>,
@@ -812,19 +809,6 @@ fn wall_chunk<const D: usize>(c: &Coefficients, lists: &Lists<D>, ksum: &[f32]) 
 }
 
 impl<const D: usize> Workspace<D> {
-    /// Starts the step control at `dt` (it grows from there as the solves allow) instead of unlimited.
-    pub fn start_at(&mut self, dt: f64) {
-        self.dt_cap = dt;
-    }
-
-    /// Starts every constant-density solve from half the last pressure, for a case with bodies (floating
-    /// bodies, fixed or not, a wave maker): a body's motion must change the pressure around it within the
-    /// step, and the solve can only add pressure (measured with the hydrostatic warm start: a floating
-    /// box's roll grows instead of decaying, its heave period leaves the band of added masses).
-    pub fn plain_warm_start(&mut self) {
-        self.plain_warm_start = true;
-    }
-
     /// Bounds the next steps by `dt` (∞: no bound), beside the flow's own limits and the iteration control.
     pub fn bound(&mut self, dt: f64) {
         self.dt_bound = if dt.is_finite() { dt } else { 0.0 };
@@ -1138,7 +1122,7 @@ pub fn step<const D: usize, K: Kernel>(
         dp,
         rho_rest: c.rho_rest,
         gz: -frame.g[2],
-        beta: if work.plain_warm_start || !Setting::applies(grid.cell_size(), dp) {
+        beta: if !Setting::applies(grid.cell_size(), dp) {
             0.0
         } else {
             spec.hydrostatic_warm_start
