@@ -1,7 +1,7 @@
 //! The discharge coefficient of a slot against its width in particle spacings, with both schemes and both
 //! kinds of wall (`sph::flooding::slot_case`: a reservoir emptying through a slot in its wall into a dry
 //! compartment; the wall fixed obstacles, or a fixed body's side): prints the manual's table
-//! (guide/flooding.md).
+//! (validation/flooding.md).
 //!
 //!     cargo run --release -p slosh-sph --example discharge_coefficient [-- --dp 0.005]
 

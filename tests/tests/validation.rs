@@ -1167,7 +1167,7 @@ fn flooding_case_a_floods_alike_with_both_schemes() {
     let litres = |v: f64| format!("{:.2} l/m", 1000.0 * v);
     for (a, b) in w.iter().zip(&d) {
         let k = (a.0 / every).round() as usize;
-        if k == 0 || (k % 2 != 0 && k != 3) {
+        if k == 0 || (!k.is_multiple_of(2) && k != 3) {
             continue;
         }
         let ratio = b.1 / a.1 - 1.0;
