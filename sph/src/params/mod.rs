@@ -81,7 +81,8 @@ pub struct DfsphSpec {
     /// with `kernel_correction` (whose pressure passes burst into noise at 0.7 in a 0.39 m deep 2D tank),
     /// 0.7 without ([`DfsphSpec::relaxation`]).
     pub relaxation: Option<f64>,
-    /// Iterations of the constant-density solver at least, and of either solver at most.
+    /// Iterations of the constant-density solver at least, and of either solver at most (a step solved
+    /// again at half the step may take twice as many as its last try, see `target_iterations`).
     pub min_iterations: u32,
     pub max_iterations: u32,
     /// Run the divergence solver (more stable at large steps).
@@ -136,7 +137,7 @@ impl Default for DfsphSpec {
             max_divergence_error: 1.0e-3,
             relaxation: None,
             min_iterations: 2,
-            max_iterations: 200,
+            max_iterations: 100,
             divergence_solve: true,
             target_iterations: 20,
             hydrostatic_warm_start: 0.95,

@@ -1202,12 +1202,18 @@ pub fn step<const D: usize, K: Kernel>(
         if let Some(r) = ranks.as_deref_mut() {
             r.sync_vector(&mut work.vel);
         }
+        // A retried step's solve may take twice the iterations of the try before: a shorter step lowers
+        // the error the flow makes within it, not one the step starts with (the liquid under a body that
+        // lands on the floor), which only more iterations remove.
+        let most = spec
+            .max_iterations
+            .saturating_mul(1 << report.retries.min(4));
         let (it, err, t) = work.solve(
             c,
             Mode::Density,
             dtf,
             tolerance,
-            (spec.min_iterations, spec.max_iterations),
+            (spec.min_iterations, most),
             (&start, 1.0),
             ranks.as_deref_mut(),
         );
