@@ -1138,15 +1138,13 @@ fn wcsph_holds_a_tilted_tank_s_weight_through_the_centroid() {
 #[test]
 fn flooding_case_a_floods_alike_with_both_schemes() {
     let started = std::time::Instant::now();
-    let spec = config::load("flooding_case_a", &[])
+    let params = config::load("flooding_case_a", &[])
         .unwrap()
         .sim_params()
-        .unwrap()
-        .bodies[0]
-        .clone();
+        .unwrap();
+    let (spec, dp) = (&params.bodies[0], params.particle_spacing);
     let hollow =
         (spec.size[0] - 2.0 * spec.wall_thickness) * (spec.size[2] - 2.0 * spec.wall_thickness);
-    let dp = 0.0025;
     let every = 0.05;
     // Time, flooded volume (m² per metre), height of the centre of gravity.
     let run = |scheme: &str| -> Vec<(f64, f64, f64)> {

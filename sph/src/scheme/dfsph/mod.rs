@@ -18,7 +18,9 @@
 //!    and a tank at rest stirs itself),
 //!    `Δv_i = −dt Σ_j m_j (k_i + k_j) ∇W_ij − dt Σ_b m_b k_i ∇W_ib` (k plays p/ρ², so p = ρ² Σ k);
 //!    A constant-density solve that stops at `max_iterations` above the tolerance is done again, with the
-//!    divergence solve, at half the step (nothing has moved yet);
+//!    divergence solve, at half the step (nothing has moved yet), allowed twice the iterations of its last
+//!    try (an error the step starts with, as under a body landing on the floor, is not lowered by a shorter
+//!    step);
 //! 4. moves the particles with the corrected velocity.
 //!
 //! Walls are the dynamic boundary's particle layers (at rest in the tank frame, or moving with a floating
