@@ -1229,3 +1229,75 @@ fn flooding_case_a_floods_alike_with_both_schemes() {
     );
     r.publish_and_check();
 }
+
+/// The discharge coefficient of a slot against its width in particle spacings (4, 8, 12, 16), with both schemes
+/// and both kinds of wall (`sph::flooding::slot_case`: the tank's obstacles, or a fixed body's side), dp 5 mm:
+/// from 8 spacings on every 0.1 s window from 0.2 s within 0.61 ± 0.06 (a sharp-edged slot: π/(π+2) in
+/// theory, 0.60–0.62 in experiment); 4 spacings printed. Draws the coefficient against the width. About
+/// twelve minutes on two cores, most of it WCSPH's.
+#[test]
+fn flooding_slot_discharge_against_the_width() {
+    use sph::flooding::{slot_case, slot_discharge, SlotWall};
+    use sph::params::Scheme;
+    let started = std::time::Instant::now();
+    let dp = 0.005;
+    let widths = [4.0, 8.0, 12.0, 16.0];
+    let mut r = Results::new(
+        "flooding_slot_discharge",
+        "flooding.md",
+        "WCSPH and DFSPH, a slot in a tank's wall (obstacles) and in a body's side, 4-16 spacings, dp 5 mm, 0-0.6 s",
+        started,
+    );
+    let mut series_list = Vec::new();
+    for wall in [SlotWall::Obstacles, SlotWall::Body] {
+        for (scheme, name) in [(Scheme::Wcsph, "wcsph"), (Scheme::Dfsph, "dfsph")] {
+            let where_ = match wall {
+                SlotWall::Obstacles => "the tank's wall",
+                SlotWall::Body => "a body's side",
+            };
+            let mut means = Vec::new();
+            for opening in widths {
+                let d = slot_discharge(slot_case(scheme, wall, opening, dp), 0.6, 0.02, (0.2, 0.1))
+                    .unwrap();
+                let cds: Vec<f64> = d.windows.iter().map(|w| w.cd).collect();
+                assert!(cds.len() >= 3, "{name}, {where_}, {opening}: {cds:?}");
+                let (lo, hi) = cds
+                    .iter()
+                    .fold((f64::MAX, f64::MIN), |(a, b), c| (a.min(*c), b.max(*c)));
+                let mean = cds.iter().sum::<f64>() / cds.len() as f64;
+                means.push(mean);
+                let quantity = format!(
+                    "`{name}`, {where_}, {opening} spacings ({:.0} mm): C_d per 0.1 s window from 0.2 s",
+                    1000.0 * d.width
+                );
+                let simulated = format!("{lo:.2}-{hi:.2} (mean {mean:.2})");
+                let reference = "0.61 (sharp-edged slot)".to_string();
+                if opening >= 8.0 {
+                    let ok = cds.iter().all(|c| (c - 0.61).abs() <= 0.06);
+                    r.row(&quantity, simulated, reference, "0.61 ± 0.06", Some(ok));
+                } else {
+                    r.row(&quantity, simulated, reference, "printed", None);
+                }
+            }
+            series_list.push(Series {
+                label: format!("{name}, {where_}"),
+                t: widths.to_vec(),
+                y: means,
+                reference: false,
+            });
+        }
+    }
+    figure_panels(
+        "flooding_slot_discharge",
+        "Discharge coefficient of a slot against its width (dp 5 mm, mean over 0.2-0.6 s)",
+        vec![Panel {
+            title: String::new(),
+            y_label: "discharge coefficient C_d".into(),
+            x_label: "slot width (particle spacings)".into(),
+            series: series_list,
+            level: Some((0.61, "sharp-edged slot, 0.61".into())),
+            markers: true,
+        }],
+    );
+    r.publish_and_check();
+}
