@@ -457,7 +457,7 @@ fn spheric10_sensor1_impacts_come_at_the_measured_times_dfsph() {
 
 /// The incompressible scheme at 4 and 2 mm, and with corrected kernel gradients at 4 mm: the impacts within
 /// 0.1 s of the measured times as at 8 mm, the rest against the targets (the slow pressure is not asserted:
-/// at 4 mm it is 21–33 % high around the first impact, outside the 8 mm runs' 25 %). About three minutes.
+/// at 4 mm it is 21–34 % high around the first impact, outside the 8 mm runs' 25 %). About three minutes.
 #[test]
 fn spheric10_sensor1_dfsph_at_finer_spacings() {
     for (overrides, dp, name, label) in [
@@ -1252,7 +1252,7 @@ fn flooding_case_a_floods_alike_with_both_schemes() {
 /// and both kinds of wall (`sph::flooding::slot_case`: the tank's obstacles, or a fixed body's side), dp 5 mm:
 /// from 8 spacings on every 0.1 s window from 0.2 s within 0.61 ± 0.06 (a sharp-edged slot: π/(π+2) in
 /// theory, 0.60–0.62 in experiment); 4 spacings printed. Draws the coefficient against the width. About
-/// twelve minutes on two cores, most of it WCSPH's.
+/// eight minutes on two cores, most of it WCSPH's.
 #[test]
 fn flooding_slot_discharge_against_the_width() {
     use sph::flooding::{slot_case, slot_discharge, SlotWall};
