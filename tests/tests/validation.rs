@@ -1267,12 +1267,11 @@ fn flooding_slot_discharge_against_the_width() {
         started,
     );
     let mut series_list = Vec::new();
-    for wall in [SlotWall::Obstacles, SlotWall::Body] {
+    for (wall, where_) in [
+        (SlotWall::Obstacles, "the tank's wall"),
+        (SlotWall::Body, "a body's side"),
+    ] {
         for (scheme, name) in [(Scheme::Wcsph, "wcsph"), (Scheme::Dfsph, "dfsph")] {
-            let where_ = match wall {
-                SlotWall::Obstacles => "the tank's wall",
-                SlotWall::Body => "a body's side",
-            };
             let mut means = Vec::new();
             for opening in widths {
                 let d = slot_discharge(slot_case(scheme, wall, opening, dp), 0.6, 0.02, (0.2, 0.1))
