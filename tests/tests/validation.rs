@@ -1296,12 +1296,7 @@ fn flooding_slot_discharge_against_the_width() {
                     r.row(&quantity, simulated, reference, "printed", None);
                 }
             }
-            series_list.push(Series {
-                label: format!("{name}, {where_}"),
-                t: widths.to_vec(),
-                y: means,
-                reference: false,
-            });
+            series_list.push(series(&format!("{name}, {where_}"), &widths, &means, false));
         }
     }
     figure_panels(
