@@ -194,6 +194,9 @@ pub fn drive(
     if let Some(f) = d.started {
         f();
     }
+    for w in params.sensors_beside_walls() {
+        eprintln!("warning: pressure_sensors: {w}");
+    }
     let mut sim = sph::build(params.clone()).map_err(|e| RunError::Solver {
         error: e,
         time: 0.0,

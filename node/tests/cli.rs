@@ -117,6 +117,35 @@ fn bad_parameters_fail_with_the_key_named() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("built-in cases"));
 }
 
+/// A pressure sensor beside a wall but off it runs, and the run says what it reads and where on the wall it
+/// would read the wall; on the wall, nothing is said.
+#[test]
+fn a_sensor_beside_a_wall_but_off_it_is_warned_about() {
+    let run = |x: &str| {
+        let out = tmp(&format!("beside_{x}"));
+        let o = slosh()
+            .args(["run", "spheric10", "--duration", "0.01", "--out"])
+            .arg(&out)
+            .args(["--set", "particle_spacing=0.008"])
+            .args(["--set", &format!("pressure_sensors.x=[{x}]")])
+            .args(["--set", "solver.scheme=dfsph"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(out.join("pressure.csv").exists());
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let e = run("-0.44");
+    assert!(
+        e.contains(
+            "warning: pressure_sensors: sensor 0 (sensor1) is 10.0 mm from the tank's -x wall"
+        ) && e.contains("pressure_sensors.x to -0.45"),
+        "{e}"
+    );
+    let e = run("-0.45");
+    assert!(!e.contains("warning"), "{e}");
+}
+
 #[test]
 fn csv_motion_drives_the_tank_and_bad_rows_are_reported_by_line() {
     let dir = tmp("csv");

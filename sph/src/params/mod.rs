@@ -1,6 +1,7 @@
 //! The typed description of a case: tank, liquid, resolution, solver choices and observation points.
 //! Plain data with defaults; [`SimParams::validate`] names the offending field of anything unusable.
 
+mod advice;
 mod bodies;
 pub mod records;
 mod validate;

@@ -503,5 +503,11 @@ impl<'c> LiveNode<'c> {
                 }
             ),
         );
+        for w in p.sensors_beside_walls() {
+            self.log(
+                ros2_client::ros2::LogLevel::Warn,
+                &format!("pressure_sensors: {w}"),
+            );
+        }
     }
 }
