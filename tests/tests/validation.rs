@@ -500,8 +500,9 @@ const SPHERIC10_REPEATS: [(f64, f64); 3] = [(3710.0, 730.0), (4820.0, 1500.0), (
 
 /// SPHERIC Test 10 (water, low fill), pressure sensor 1 under the measured roll law at spacing `dp`, with
 /// `overrides`; draws the figure `name`. The first three impacts come within 0.1 s of the measured ones and
-/// the slow pressure before the first and after it within 25 %; the table also shows the targets: impacts
-/// within 30 ms, their peaks inside the repeats' mean ± 2σ, the slow pressure between impacts within 15 %.
+/// the slow pressure before the first and after it within 15 % (25 % at 8 mm); the table also shows the
+/// targets: impacts within 30 ms, their peaks inside the repeats' mean ± 2σ, the slow pressure between
+/// impacts within 15 %.
 /// The sensor is read on the wall's face (the case's sensor sits on it), as the flush transducer reads it.
 fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str) {
     let started = std::time::Instant::now();
@@ -608,6 +609,9 @@ fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str) {
             .collect();
         v.iter().sum::<f64>() / v.len().max(1) as f64
     };
+    // Around the first impact the target's 15 % from 4 mm on; at 8 mm, where the sensor's reach along the
+    // wall (2h, 21 mm) is most of the water's 30 mm run-up above it, 25 %.
+    let bound = if dp <= 0.004 { 0.15 } else { 0.25 };
     for (lo, hi) in [(0.6, 1.2), (2.45, 2.85), (4.15, 4.45), (5.75, 6.0)] {
         let (ms, me) = (mean_in(&t, &p, lo, hi), mean_in(&te, &pe, lo, hi));
         eprintln!("SPHERIC 10 ({label}) mean pressure {lo}-{hi} s: simulated {ms:.0} Pa, measured {me:.0} Pa");
@@ -615,11 +619,14 @@ fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str) {
         if hi < 3.0 {
             r.row(
                 &quantity,
-                format!("{ms:.0} Pa"),
+                format!("{ms:.0} Pa ({:+.0} %)", (ms / me - 1.0) * 100.0),
                 format!("{me:.0} Pa"),
-                "± 25 %",
-                Some((ms - me).abs() < 0.25 * me),
+                &format!("± {:.0} %", bound * 100.0),
+                Some((ms - me).abs() < bound * me),
             );
+            if bound <= 0.15 {
+                continue;
+            }
         }
         r.target(
             &format!("{quantity}, against the target"),
