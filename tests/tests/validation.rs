@@ -610,7 +610,7 @@ fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str) {
         v.iter().sum::<f64>() / v.len().max(1) as f64
     };
     // Around the first impact the target's 15 % from 4 mm on; at 8 mm, where the sensor's reach along the
-    // wall (2h, 21 mm) is most of the water's 30 mm run-up above it, 25 %.
+    // wall (2h, 21 mm) is most of the 30 mm of water above it in the first rise, 25 %.
     let bound = if dp <= 0.004 { 0.15 } else { 0.25 };
     for (lo, hi) in [(0.6, 1.2), (2.45, 2.85), (4.15, 4.45), (5.75, 6.0)] {
         let (ms, me) = (mean_in(&t, &p, lo, hi), mean_in(&te, &pe, lo, hi));
