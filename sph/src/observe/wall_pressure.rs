@@ -22,21 +22,22 @@ pub struct Face {
     pub obstacle: Option<usize>,
 }
 
-/// The face of the tank the point `p` lies on (within `tol`): its axis and outward sign (+1: the `hi` face).
+/// The face of the tank the point `p` lies on (within `tol`): its axis and outward sign (+1: the `hi` face);
+/// the nearest where `p` is within `tol` of two (in a corner).
 pub fn face_of<const D: usize>(tank: &TankBox<D>, p: [f64; D], tol: f64) -> Option<(usize, f64)> {
-    (0..D).find_map(|a| {
-        let inside =
-            (0..D).all(|d| d == a || (p[d] >= tank.lo[d] - tol && p[d] <= tank.hi[d] + tol));
-        if !inside {
-            None
-        } else if (p[a] - tank.lo[a]).abs() <= tol {
-            Some((a, -1.0))
-        } else if (p[a] - tank.hi[a]).abs() <= tol {
-            Some((a, 1.0))
-        } else {
-            None
-        }
-    })
+    (0..D)
+        .filter(|&a| {
+            (0..D).all(|d| d == a || (p[d] >= tank.lo[d] - tol && p[d] <= tank.hi[d] + tol))
+        })
+        .flat_map(|a| {
+            [
+                (a, -1.0, (p[a] - tank.lo[a]).abs()),
+                (a, 1.0, (p[a] - tank.hi[a]).abs()),
+            ]
+        })
+        .filter(|f| f.2 <= tol)
+        .min_by(|x, y| x.2.total_cmp(&y.2))
+        .map(|(a, sign, _)| (a, sign))
 }
 
 /// The face of an obstacle box (tank frame) the point `p` lies on within `tol`, with its distance from it;
@@ -313,6 +314,10 @@ mod tests {
         assert_eq!(at([0.053, 0.0, 0.099]), face(2, -1.0, Some(0)));
         assert_eq!(at([0.051, 0.0, 0.004]), face(0, 1.0, Some(0)));
         assert_eq!(at([0.054, 0.0, 0.002]), face(2, -1.0, None));
+        // In a corner of the tank, the nearer of its two walls, whichever axis comes first.
+        assert_eq!(at([0.497, 0.0, 0.001]), face(2, -1.0, None));
+        assert_eq!(at([0.499, 0.0, 0.003]), face(0, 1.0, None));
+        assert_eq!(at([-0.496, 0.249, 0.3]), face(1, 1.0, None));
         // In the liquid, or beside the block but beyond its extent: no face.
         assert_eq!(at([0.0, 0.0, 0.2]), None);
         assert_eq!(at([0.05, 0.0, 0.12]), None);
