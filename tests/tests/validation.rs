@@ -1106,7 +1106,7 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
 }
 
 /// SPHERIC Test 2 (Kleefsman et al. 2005) at 20 mm, the impact on the box: the case's incompressible scheme
-/// over 0-0.7 s (85,400 liquid particles; about 70 s on two cores), sampled every millisecond as the record
+/// over 0-0.7 s (85,400 liquid particles; about 40 s on two cores), sampled every millisecond as the record
 /// is. Asserted as at 40 mm: the front's arrival at H1 and H2 within 0.05 s and the impact on P1-P4 (the
 /// pressure passing 500 Pa) within 0.03 s. Held to targets and shown inside or outside them, not asserted:
 /// the reservoir's level (H4) falling below 0.5 m within 0.05 s (it lags by about that much at this spacing:
