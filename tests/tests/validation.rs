@@ -923,6 +923,22 @@ fn bouscasse_2013(overrides: &[&str], name: &str, label: &str) {
     r.publish_and_check();
 }
 
+/// SPHERIC Test 2's front at water-height probe `k` (0-3, named `name`) sampled at times `t`: the first time
+/// its height passes 5 cm; at H4 (k = 3), in the reservoir, the first time its level falls below 0.5 m.
+fn kleefsman_arrival(k: usize, name: &str, t: &[f64], h: &[f64]) -> f64 {
+    let i = h
+        .iter()
+        .position(|&v| if k == 3 { v < 0.5 } else { v > 0.05 })
+        .unwrap_or_else(|| panic!("{name}: the front never arrives"));
+    t[i]
+}
+
+/// SPHERIC Test 2's impact at a pressure sensor sampled at times `t`: the first time its pressure passes
+/// 500 Pa (the last time if it never does).
+fn kleefsman_impact(t: &[f64], p: &[f64]) -> f64 {
+    t[p.iter().position(|&x| x > 500.0).unwrap_or(p.len() - 1)]
+}
+
 /// SPHERIC Test 2 (Kleefsman et al. 2005): the 3D dam break onto a box fixed to the floor (`obstacles`), with
 /// the case's incompressible scheme at 40 mm, 0-6 s: the water heights H1-H4 against the record, each in
 /// shape (correlation > 0.85) and size (rms within 25 %), and the front's arrival at H1, H2 (0.5 and 1.0 m
@@ -957,15 +973,10 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
             (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
         };
         let ratio = std(&at) / std(&he);
-        // The front's arrival: the first time the height passes 5 cm (H4, in the reservoir: falls below 0.5 m).
-        let arrival = |ts: &[f64], h: &[f64]| {
-            let i = h
-                .iter()
-                .position(|&v| if k == 3 { v < 0.5 } else { v > 0.05 })
-                .unwrap_or_else(|| panic!("{name}: the front never arrives"));
-            ts[i]
-        };
-        let (a_sim, a_exp) = (arrival(&t, &hs), arrival(&te, &he));
+        let (a_sim, a_exp) = (
+            kleefsman_arrival(k, name, &t, &hs),
+            kleefsman_arrival(k, name, &te, &he),
+        );
         eprintln!(
             "Kleefsman 2005 (DFSPH, dp 40 mm) {name}: correlation {corr:.3}, rms {:.3} m against {:.3} m, peak {:.3} m against {:.3} m, front at {a_sim:.3} s against {a_exp:.3} s",
             std(&at),
@@ -1038,9 +1049,7 @@ fn kleefsman_2005_dam_break_onto_a_box_water_heights_dfsph() {
             w.iter().sum::<f64>() / w.len() as f64
         };
         let (ms, me) = (mean_after(&at), mean_after(&pe));
-        // The impact: the first time the pressure passes 500 Pa.
-        let wet = |v: &[f64]| te[v.iter().position(|&p| p > 500.0).unwrap_or(v.len() - 1)];
-        let (ws, we) = (wet(&at), wet(&pe));
+        let (ws, we) = (kleefsman_impact(&te, &at), kleefsman_impact(&te, &pe));
         eprintln!(
             "Kleefsman 2005 (DFSPH, dp 40 mm) {name}: correlation {corr:.3}, mean after 1 s {ms:.0} Pa against {me:.0} Pa, peak {:.0} Pa against {:.0} Pa, above 500 Pa from {ws:.3} s against {we:.3} s",
             at.iter().cloned().fold(0.0, f64::max),
@@ -1135,18 +1144,13 @@ fn kleefsman_2005_impact_on_the_box_at_20_mm_dfsph() {
         "DFSPH, dp 20 mm, 0-0.7 s, sampled every 1 ms",
         started,
     );
-    // The front's arrival: the height passing 5 cm (H4, in the reservoir: falling below 0.5 m).
     for (k, name) in [(0, "H1"), (1, "H2"), (3, "H4")] {
         let he: Vec<f64> = exp.iter().map(|r| r[9 + k]).collect();
         let hs: Vec<f64> = obs.iter().map(|o| o.probes[k]).collect();
-        let arrival = |ts: &[f64], h: &[f64]| {
-            let i = h
-                .iter()
-                .position(|&v| if k == 3 { v < 0.5 } else { v > 0.05 })
-                .unwrap_or_else(|| panic!("{name}: the front never arrives"));
-            ts[i]
-        };
-        let (a_sim, a_exp) = (arrival(&t, &hs), arrival(&te, &he));
+        let (a_sim, a_exp) = (
+            kleefsman_arrival(k, name, &t, &hs),
+            kleefsman_arrival(k, name, &te, &he),
+        );
         let (quantity, ok) = (
             format!("{name}: the front's arrival"),
             (a_sim - a_exp).abs() < 0.05,
@@ -1170,8 +1174,7 @@ fn kleefsman_2005_impact_on_the_box_at_20_mm_dfsph() {
         let pick = |v: &[f64], idx: &[usize]| -> Vec<f64> { idx.iter().map(|&i| v[i]).collect() };
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
         let peak = |v: &[f64]| v.iter().cloned().fold(f64::MIN, f64::max);
-        let wet = |v: &[f64]| te[v.iter().position(|&p| p > 500.0).unwrap_or(v.len() - 1)];
-        let (ws, we) = (wet(&at), wet(&pe));
+        let (ws, we) = (kleefsman_impact(&te, &at), kleefsman_impact(&te, &pe));
         let (peak_s, peak_e) = (peak(&at), peak(&pe));
         let (mean_s, mean_e) = (mean(&pick(&at, &run_up)), mean(&pick(&pe, &run_up)));
         let corr = correlation(&pick(&at, &impact), &pick(&pe, &impact));
