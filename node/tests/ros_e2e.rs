@@ -1351,3 +1351,109 @@ fn realtime_mode_chooses_the_resolution_from_a_timed_trial() {
     assert!(!slow.exists(), "nothing is recorded");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout() {
+    if !common::in_private_netns("the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout") {
+        return;
+    }
+    let (dir, case) = common::case_dir("ros-log-level", "");
+    // A node that never gets motion: it says its parameters (info), at the end that its recording holds no
+    // simulation (warn), then that it stops (info). /rosout is read by Cyclone DDS, a third-party reader.
+    let run = |domain: u16, extra: &[&str]| -> (String, Vec<(u8, String)>) {
+        let bag = dir.join(format!("bag{domain}"));
+        let record = format!("record.path:={}", bag.display());
+        let mut args = vec!["-p", &record];
+        args.extend_from_slice(extra);
+        let (_ctx, node) = common::participant(domain, "e2e_log");
+        let proc = logged_node(&node, &case, &args, domain, &["/motion/odom"]);
+        let mut reader = Command::new(common::python())
+            .arg(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../tests/py/rosout_cyclonedds.py"
+            ))
+            .args(["--domain", &domain.to_string(), "--seconds", "4"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut ready = String::new();
+        std::io::BufRead::read_line(
+            &mut std::io::BufReader::new(reader.stderr.as_mut().unwrap()),
+            &mut ready,
+        )
+        .unwrap();
+        assert_eq!(ready.trim(), "ready", "the /rosout reader did not start");
+        std::thread::sleep(Duration::from_millis(1000));
+        let log = stop_logged(proc);
+        let out = reader.wait_with_output().unwrap();
+        assert!(out.status.success(), "the /rosout reader failed");
+        let got: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let rosout = got
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| {
+                (
+                    m["level"].as_u64().unwrap() as u8,
+                    m["msg"].as_str().unwrap().to_string(),
+                )
+            })
+            .collect();
+        (log, rosout)
+    };
+    let said = |out: &[(u8, String)], text: &str| {
+        out.iter().find(|(_, m)| m.contains(text)).map(|(l, _)| *l)
+    };
+    let (warn, info) = (ros2_client::log::Log::WARN, ros2_client::log::Log::INFO);
+
+    let (log, rosout) = run(53, &[]);
+    for text in [
+        "] parameters ",
+        "] no motion sample was accepted",
+        "] stopping at t = ",
+    ] {
+        assert!(
+            log.contains(text),
+            "`{text}` missing from the default log:\n{log}"
+        );
+    }
+    assert_eq!(
+        said(&rosout, "no motion sample was accepted"),
+        Some(warn),
+        "{rosout:?}"
+    );
+    assert_eq!(said(&rosout, "stopping at t = "), Some(info), "{rosout:?}");
+
+    // Warnings and worse only, on both outputs.
+    let (log, rosout) = run(54, &["--log-level", "WARN"]);
+    assert!(log.contains("] no motion sample was accepted"), "{log}");
+    for text in ["] parameters ", "] stopping at t = "] {
+        assert!(!log.contains(text), "`{text}` said below the level:\n{log}");
+    }
+    assert_eq!(
+        said(&rosout, "no motion sample was accepted"),
+        Some(warn),
+        "{rosout:?}"
+    );
+    assert!(rosout.iter().all(|(l, _)| *l >= warn), "{rosout:?}");
+
+    // The node's own logger at error wins over a plain debug; nothing on stderr at all, and with
+    // --disable-rosout-logs nothing on /rosout either.
+    let (log, rosout) = run(
+        55,
+        &[
+            "--log-level",
+            "slosh:=error",
+            "--log-level",
+            "debug",
+            "--disable-stdout-logs",
+        ],
+    );
+    assert!(!log.contains("[/slosh]"), "{log}");
+    assert!(rosout.is_empty(), "{rosout:?}");
+    let (log, rosout) = run(56, &["--disable-rosout-logs"]);
+    assert!(log.contains("] stopping at t = "), "{log}");
+    assert!(rosout.is_empty(), "{rosout:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,6 +1,7 @@
 //! The ROS 2 command-line arguments a node accepts after `--ros-args` (as `rcl` parses them): parameter files,
-//! `-p name:=value`, remapping rules `-r from:=to` (including `__ns` and `__node`), `--log-level`, and `--enclave`
-//! (accepted and ignored). Names are resolved and remapped here, since ros2-client does neither.
+//! `-p name:=value`, remapping rules `-r from:=to` (including `__ns` and `__node`), `--log-level` and the
+//! log's outputs (applied by [`super::logging`]), and `--enclave` (accepted and ignored: the enclave is
+//! `ROS_SECURITY_ENCLAVE_OVERRIDE`'s). Names are resolved and remapped here, since ros2-client does neither.
 
 use std::fmt;
 
@@ -17,8 +18,12 @@ pub struct RosArgs {
     pub namespace: Option<String>,
     /// `-r __node:=name`.
     pub node_name: Option<String>,
-    /// `--log-level LEVEL`.
-    pub log_level: Option<String>,
+    /// `--log-level LEVEL` (None) and `--log-level NAME:=LEVEL` (the logger's name), in order.
+    pub log_levels: Vec<(Option<String>, super::logging::LogLevel)>,
+    /// `--disable-stdout-logs` (undone by a later `--enable-stdout-logs`).
+    pub disable_stdout_logs: bool,
+    /// `--disable-rosout-logs`.
+    pub disable_rosout_logs: bool,
 }
 
 /// A malformed argument, with what was expected.
@@ -73,14 +78,28 @@ pub fn parse(args: &[String]) -> Result<(Vec<String>, RosArgs), ArgError> {
                         _ => out.remaps.push((from.to_string(), to.to_string())),
                     }
                 }
-                "--log-level" => out.log_level = Some(next(&mut i, a)?),
+                "--log-level" => {
+                    let v = next(&mut i, a)?;
+                    let level = match v.split_once(":=") {
+                        Some(("", _)) => {
+                            return Err(ArgError(format!(
+                                "`--log-level {v}`: expected LEVEL or LOGGER:=LEVEL"
+                            )))
+                        }
+                        Some((name, l)) => (Some(name.to_string()), super::logging::parse_level(l)?),
+                        None => (None, super::logging::parse_level(&v)?),
+                    };
+                    out.log_levels.push(level);
+                }
                 "-e" | "--enclave" => {
                     next(&mut i, a)?;
                 }
-                "--disable-rosout-logs" | "--disable-stdout-logs" | "--enable-stdout-logs" => {}
+                "--disable-rosout-logs" => out.disable_rosout_logs = true,
+                "--disable-stdout-logs" => out.disable_stdout_logs = true,
+                "--enable-stdout-logs" => out.disable_stdout_logs = false,
                 other => {
                     return Err(ArgError(format!(
-                        "unknown argument `{other}` (accepted: --params-file FILE, -p name:=value, -r from:=to, -r __ns:=/ns, -r __node:=name, --log-level LEVEL){}",
+                        "unknown argument `{other}` (accepted: --params-file FILE, -p name:=value, -r from:=to, -r __ns:=/ns, -r __node:=name, --log-level [LOGGER:=]LEVEL, --disable-stdout-logs, --disable-rosout-logs){}",
                         if other.starts_with("--") {
                             "; slosh's own options, such as --duration, go before --ros-args (or after a closing --)"
                         } else {
@@ -188,6 +207,11 @@ impl Names {
         }
     }
 
+    /// The node's logger name as rcl names it: the namespace and the node joined by dots (`ship1.slosh`).
+    pub fn logger_name(&self) -> String {
+        self.node_fqn().trim_start_matches('/').replace('/', ".")
+    }
+
     /// The fully qualified name without remapping: relative names go under the namespace, `~` is the node.
     fn expand(&self, name: &str) -> Result<String, ArgError> {
         let ns = if self.namespace == "/" {
@@ -258,7 +282,10 @@ mod tests {
         );
         assert_eq!(r.namespace.as_deref(), Some("/ship1"));
         assert_eq!(r.node_name.as_deref(), Some("tank2"));
-        assert_eq!(r.log_level.as_deref(), Some("debug"));
+        assert_eq!(
+            r.log_levels,
+            [(None, super::super::logging::LogLevel::Debug)]
+        );
         let (plain, _) = parse(&args("--x 1 --ros-args -p a:=1 -- tail")).unwrap();
         assert_eq!(plain, ["--x", "1", "tail"]);
     }

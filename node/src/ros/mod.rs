@@ -4,6 +4,7 @@
 pub mod args;
 pub mod cloud;
 pub mod graph_hint;
+pub mod logging;
 pub mod motion_pub;
 pub mod node;
 pub mod pacing;

@@ -3,6 +3,7 @@
 //! for headless CI and demos. Paced by the wall clock, or in lockstep with a simulation's `/clock`.
 
 use super::args::{Names, RosArgs};
+use super::logging::{LogLevel, Logger};
 use super::publish;
 use crate::messages::motion::{accel, imu, odometry};
 use crate::motion_source::{checked_motion, MotionOptions};
@@ -20,6 +21,7 @@ use std::time::{Duration, Instant};
 pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<()> {
     let (cfg, motion) = checked_motion(config, &ros.params, opts)?;
     let names = Names::new(ros, "slosh_motion")?;
+    let log = Logger::new(ros, &names, "slosh motion: ");
     let stop = crate::signals::shutdown_flag()?;
     let context = super::context()?;
     let mut node = context
@@ -80,9 +82,12 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
         "motion/odom"
     })?;
     if opts.wait_for_subscribers > 0 {
-        eprintln!(
-            "slosh motion: waiting for {} subscriber(s) on {odom_topic}",
-            opts.wait_for_subscribers
+        log.say(
+            LogLevel::Info,
+            &format!(
+                "waiting for {} subscriber(s) on {odom_topic}",
+                opts.wait_for_subscribers
+            ),
         );
         while node.subscription_count(&odom_topic) < opts.wait_for_subscribers {
             if stop.load(Ordering::Relaxed) {
@@ -98,16 +103,19 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
     let lead = 4u64;
     let mut clock_t = f64::NEG_INFINITY;
     let start = Instant::now();
-    eprintln!(
-        "slosh motion: publishing {} samples (t = 0 to {} s) at {} Hz on {odom_topic}{}",
-        n + 1,
-        n as f64 / opts.rate_hz,
-        opts.rate_hz,
-        if opts.lockstep {
-            " in lockstep with /clock"
-        } else {
-            ""
-        }
+    log.say(
+        LogLevel::Info,
+        &format!(
+            "publishing {} samples (t = 0 to {} s) at {} Hz on {odom_topic}{}",
+            n + 1,
+            n as f64 / opts.rate_hz,
+            opts.rate_hz,
+            if opts.lockstep {
+                " in lockstep with /clock"
+            } else {
+                ""
+            }
+        ),
     );
     // Lockstep: whether the simulation has been seen subscribed (once it has gone, nothing will move /clock).
     let mut subscribed = false;
@@ -130,19 +138,19 @@ pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<
                     let count = node.subscription_count(&odom_topic);
                     subscribed |= count > 0;
                     if subscribed && count == 0 {
-                        eprintln!(
-                            "slosh motion: {odom_topic} has no subscriber any more (the simulation ended?): stopping at t = {t:.3} s after {k} of {} samples",
+                        log.say(LogLevel::Info, &format!(
+                            "{odom_topic} has no subscriber any more (the simulation ended?): stopping at t = {t:.3} s after {k} of {} samples",
                             n + 1
-                        );
+                        ));
                         return Ok(());
                     }
                     if reminded.elapsed() > Duration::from_secs(10) {
                         reminded = Instant::now();
-                        eprintln!(
-                            "slosh motion: --lockstep: waiting for /clock to pass t = {:.3} s (it reads {}): is the simulation running, in realtime.mode lockstep, on this ROS_DOMAIN_ID?",
+                        log.say(LogLevel::Warn, &format!(
+                            "--lockstep: waiting for /clock to pass t = {:.3} s (it reads {}): is the simulation running, in realtime.mode lockstep, on this ROS_DOMAIN_ID?",
                             t - lead as f64 / opts.rate_hz,
                             if clock_t.is_finite() { format!("{clock_t:.3} s") } else { "nothing yet".into() }
-                        );
+                        ));
                     }
                 }
             }

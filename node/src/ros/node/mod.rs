@@ -27,6 +27,7 @@ mod services;
 mod start;
 
 use super::args::{Names, RosArgs};
+use super::logging::Logger;
 use super::parameters::{LiveSettings, ParameterServers, Parameters};
 use crate::config::{Loaded, DEFAULT_NAME};
 use crate::input::frames::Frames;
@@ -82,10 +83,11 @@ pub fn run(
     start::check_settings(&cfg)?;
     // Before the resolution trials, so that a signal during them stops the node cleanly too.
     let stop = crate::signals::shutdown_flag()?;
-    let Some(resolution) = start::resolution(&cfg, &names, &stop)? else {
+    let logger = Logger::new(ros, &names, &format!("[{}] ", names.node_fqn()));
+    let Some(resolution) = start::resolution(&cfg, &logger, &stop)? else {
         return Ok(());
     };
-    let mut node = LiveNode::start(&cfg, &names, params, resolution)?;
+    let mut node = LiveNode::start(&cfg, &names, logger, params, resolution)?;
     while !stop.load(Ordering::Relaxed) {
         if node.pass(&stop, opts.duration)? == Flow::Stop {
             break;
@@ -196,6 +198,8 @@ struct LiveNode<'c> {
     cfg: &'c Loaded,
     params: sph::params::SimParams,
     full_name: String,
+    /// Where [`Self::log`] says what, from which level (`--log-level`).
+    logger: Logger,
     /// (Before the endpoints: on an early way out its `Drop` finishes the recording while the node is up.)
     recorder: Option<Recorder>,
     ends: Endpoints,
@@ -251,10 +255,12 @@ impl LiveNode<'_> {
         self.report.start.elapsed().as_secs_f64()
     }
 
-    /// Says `msg` on stderr and on `/rosout`.
+    /// Says `msg` on stderr and on `/rosout`, as far as `--log-level` and the log's outputs let it.
     fn log(&self, level: ros2_client::ros2::LogLevel, msg: &str) {
-        eprintln!("[{}] {msg}", self.full_name);
-        ros2_client::rosout!(self.ends.node, level, "{}", msg);
+        self.logger.say(level, msg);
+        if self.logger.to_rosout(level) {
+            ros2_client::rosout!(self.ends.node, level, "{}", msg);
+        }
     }
 
     /// The motion of a fresh start (after a reset, a resume or a new time base).
@@ -307,9 +313,12 @@ impl LiveNode<'_> {
         });
         if let Some(mut r) = self.recorder.take() {
             if self.report.counters.accepted == 0 {
-                eprintln!(
-                    "[{}] no motion sample was accepted: the bag {} holds no simulation",
-                    self.full_name, self.cfg.config.record.path
+                self.log(
+                    ros2_client::ros2::LogLevel::Warn,
+                    &format!(
+                        "no motion sample was accepted: the bag {} holds no simulation",
+                        self.cfg.config.record.path
+                    ),
                 );
             }
             for s in self.intake.other_base.drain(..) {

@@ -239,7 +239,10 @@ impl LiveNode<'_> {
             }
         }
         if let Err(e) = self.ends.out.diag.publish(d) {
-            eprintln!("[{}] publishing /diagnostics: {e:?}", self.full_name);
+            self.log(
+                ros2_client::ros2::LogLevel::Error,
+                &format!("publishing /diagnostics: {e:?}"),
+            );
         }
         Ok(())
     }

@@ -32,12 +32,14 @@ impl LiveNode<'_> {
         let before = self.live;
         let name = self.full_name.clone();
         let ends = &mut self.ends;
-        let node = &ends.node;
+        let (node, logger) = (&ends.node, &self.logger);
         ends.srv
             .parameters
             .serve(&mut self.table, &mut self.live, &name, |m| {
-                eprintln!("[{name}] {m}");
-                ros2_client::rosout!(*node, LogLevel::Info, "{}", m);
+                logger.say(LogLevel::Info, m);
+                if logger.to_rosout(LogLevel::Info) {
+                    ros2_client::rosout!(*node, LogLevel::Info, "{}", m);
+                }
             })?;
         if self.live != before {
             let t = self.sim.time();

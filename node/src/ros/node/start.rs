@@ -11,6 +11,7 @@ use crate::input::live_motion::Limits;
 use crate::messages::body_topic;
 use crate::record::Recorder;
 use crate::ros::args::Names;
+use crate::ros::logging::{LogLevel, Logger};
 use crate::ros::pacing::Pacing;
 use crate::ros::parameters::{LiveSettings, ParameterServers, Parameters};
 use crate::ros::{publisher, subscription};
@@ -104,7 +105,7 @@ pub(super) struct Resolution {
 /// trials choose (None: a signal stopped them).
 pub(super) fn resolution(
     cfg: &Loaded,
-    names: &Names,
+    log: &Logger,
     stop: &AtomicBool,
 ) -> anyhow::Result<Option<Resolution>> {
     let c = &cfg.config;
@@ -123,9 +124,10 @@ pub(super) fn resolution(
         return off("off (only in realtime mode)");
     }
     auto.check(cfg)?;
-    let say = |m: &str| eprintln!("[{}] {m}", names.node);
+    let say = |m: &str| log.say(LogLevel::Info, m);
+    let warn = |m: &str| log.say(LogLevel::Warn, m);
     if c.solver.scheme == sph::params::Scheme::Wcsph {
-        say("realtime.auto_resolution with solver.scheme: wcsph: the weakly-compressible scheme's steps follow the speed of sound, so only very coarse spacings keep real time; solver.scheme: dfsph is the scheme for real time");
+        warn("realtime.auto_resolution with solver.scheme: wcsph: the weakly-compressible scheme's steps follow the speed of sound, so only very coarse spacings keep real time; solver.scheme: dfsph is the scheme for real time");
     }
     say(&format!(
         "realtime.auto_resolution: timing {} s trials of {} (target real-time factor {}) ...",
@@ -144,7 +146,7 @@ pub(super) fn resolution(
         say(&format!("realtime.auto_resolution: {why}"));
     }
     if let Some(w) = &choice.accuracy_warning {
-        say(&format!("warning: realtime.auto_resolution: {w}"));
+        warn(&format!("warning: realtime.auto_resolution: {w}"));
     }
     Ok(Some(Resolution {
         particle_spacing: Some(choice.particle_spacing),
@@ -163,6 +165,7 @@ impl Endpoints {
         names: &Names,
         params: &sph::params::SimParams,
         particles: usize,
+        rosout: bool,
     ) -> anyhow::Result<Self> {
         let c = &cfg.config;
         let iox = &c.iceoryx2;
@@ -172,7 +175,7 @@ impl Endpoints {
                 NodeName::new(&names.namespace, &names.node).map_err(|e| {
                     anyhow::anyhow!("node name {}/{}: {e:?}", names.namespace, names.node)
                 })?,
-                NodeOptions::new().enable_rosout(true),
+                NodeOptions::new().enable_rosout(rosout),
             )
             .map_err(|e| anyhow::anyhow!("cannot create the node: {e:?}"))?;
         let iox_node = open_iceoryx2(cfg, names, params)?;
@@ -415,6 +418,7 @@ impl<'c> LiveNode<'c> {
     pub(super) fn start(
         cfg: &'c Loaded,
         names: &Names,
+        logger: Logger,
         mut params: sph::params::SimParams,
         resolution: Resolution,
     ) -> anyhow::Result<Self> {
@@ -427,7 +431,13 @@ impl<'c> LiveNode<'c> {
         }
         let sim = sph::build(params.clone())?;
         let counts = sim.counts();
-        let ends = Endpoints::open(cfg, names, &params, counts.fluid + counts.boundary)?;
+        let ends = Endpoints::open(
+            cfg,
+            names,
+            &params,
+            counts.fluid + counts.boundary,
+            logger.rosout(),
+        )?;
         // Every parameter as the node runs with it: the parameter services' table and the recording's
         // metadata.
         let effective = cfg.effective_parameters(&params);
@@ -451,6 +461,7 @@ impl<'c> LiveNode<'c> {
         let node = Self {
             cfg,
             full_name: names.node_fqn(),
+            logger,
             table,
             live: LiveSettings {
                 output_rate_hz: c.output_rate_hz,

@@ -1,0 +1,132 @@
+//! The log of `slosh node` and `slosh motion` as rcl's arguments set it: `--log-level LEVEL` (every logger)
+//! or `--log-level NAME:=LEVEL` (the logger of that name: a node's is its namespace and name joined by dots,
+//! `ship1.slosh`), `--disable-stdout-logs` (nothing on stderr) and `--disable-rosout-logs` (nothing on
+//! `/rosout`). A message below the level goes nowhere.
+
+use super::args::{ArgError, Names, RosArgs};
+pub use ros2_client::ros2::LogLevel;
+
+/// Parses a severity as rcutils does: any case, `warning` for `warn`.
+pub fn parse_level(s: &str) -> Result<LogLevel, ArgError> {
+    match s.to_ascii_lowercase().as_str() {
+        "debug" => Ok(LogLevel::Debug),
+        "info" => Ok(LogLevel::Info),
+        "warn" | "warning" => Ok(LogLevel::Warn),
+        "error" => Ok(LogLevel::Error),
+        "fatal" => Ok(LogLevel::Fatal),
+        _ => Err(ArgError(format!(
+            "`--log-level {s}`: expected debug, info, warn, error or fatal (any case), or LOGGER:=LEVEL"
+        ))),
+    }
+}
+
+/// Where a process's messages go, and from which level.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Logger {
+    /// What each stderr line starts with.
+    prefix: String,
+    /// The least severe level said.
+    level: LogLevel,
+    stderr: bool,
+    rosout: bool,
+}
+
+impl Logger {
+    /// The logger of the node `names` names, set by `args`: its own `NAME:=LEVEL` wins over a plain level;
+    /// info when neither is given. `prefix` starts each stderr line (`"[/ship1/slosh] "`).
+    pub fn new(args: &RosArgs, names: &Names, prefix: &str) -> Self {
+        let own = names.logger_name();
+        let named = args
+            .log_levels
+            .iter()
+            .rev()
+            .find(|(n, _)| n.as_deref() == Some(own.as_str()));
+        let plain = args.log_levels.iter().rev().find(|(n, _)| n.is_none());
+        Self {
+            prefix: prefix.to_string(),
+            level: named.or(plain).map_or(LogLevel::Info, |(_, l)| *l),
+            stderr: !args.disable_stdout_logs,
+            rosout: !args.disable_rosout_logs,
+        }
+    }
+
+    /// Whether a message of `level` is said at all.
+    pub fn enabled(&self, level: LogLevel) -> bool {
+        level >= self.level
+    }
+
+    /// Whether a message of `level` goes to `/rosout`.
+    pub fn to_rosout(&self, level: LogLevel) -> bool {
+        self.rosout && self.enabled(level)
+    }
+
+    /// Whether the node publishes on `/rosout` at all.
+    pub fn rosout(&self) -> bool {
+        self.rosout
+    }
+
+    /// Writes `msg` on stderr if `level` is said there.
+    pub fn say(&self, level: LogLevel, msg: &str) {
+        if self.stderr && self.enabled(level) {
+            eprintln!("{}{msg}", self.prefix);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ros::args::parse;
+
+    fn logger(a: &str) -> Logger {
+        let args: Vec<String> = a.split_whitespace().map(String::from).collect();
+        let (_, r) = parse(&args).unwrap();
+        let names = Names::new(&r, "slosh").unwrap();
+        Logger::new(&r, &names, "[/ship1/slosh] ")
+    }
+
+    #[test]
+    fn the_level_and_the_outputs_follow_the_arguments() {
+        let l = logger("--ros-args");
+        assert!(l.enabled(LogLevel::Info) && !l.enabled(LogLevel::Debug));
+        assert!(l.rosout() && l.to_rosout(LogLevel::Info));
+        let l = logger("--ros-args --log-level WARNING");
+        assert!(!l.enabled(LogLevel::Info) && l.enabled(LogLevel::Warn));
+        assert!(l.enabled(LogLevel::Fatal) && !l.to_rosout(LogLevel::Info));
+        let l = logger("--ros-args --log-level debug --disable-rosout-logs");
+        assert!(l.enabled(LogLevel::Debug) && !l.rosout() && !l.to_rosout(LogLevel::Fatal));
+        // The node's own logger (namespace and name joined by dots) wins over a plain level, in any order;
+        // another logger's level changes nothing here.
+        let l =
+            logger("--ros-args -r __ns:=/ship1 --log-level ship1.slosh:=error --log-level debug");
+        assert!(!l.enabled(LogLevel::Warn) && l.enabled(LogLevel::Error));
+        let l = logger("--ros-args -r __ns:=/ship1 --log-level other:=debug");
+        assert!(!l.enabled(LogLevel::Debug) && l.enabled(LogLevel::Info));
+        let l = logger("--ros-args --log-level slosh:=fatal");
+        assert!(!l.enabled(LogLevel::Error));
+        // The last of two plain levels counts, as in rcl.
+        assert!(logger("--ros-args --log-level error --log-level info").enabled(LogLevel::Info));
+    }
+
+    #[test]
+    fn a_bad_level_is_refused_naming_the_levels() {
+        for a in [
+            "--ros-args --log-level verbose",
+            "--ros-args --log-level slosh:=loud",
+        ] {
+            let args: Vec<String> = a.split_whitespace().map(String::from).collect();
+            let e = parse(&args).unwrap_err().to_string();
+            assert!(
+                e.contains("expected debug, info, warn, error or fatal"),
+                "{e}"
+            );
+        }
+        let args: Vec<String> = ["--ros-args", "--log-level", ":=info"]
+            .map(String::from)
+            .into();
+        assert!(parse(&args)
+            .unwrap_err()
+            .to_string()
+            .contains("LOGGER:=LEVEL"));
+    }
+}
