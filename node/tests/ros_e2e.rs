@@ -1407,17 +1407,25 @@ fn the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout() {
     };
     let (warn, info) = (ros2_client::log::Log::WARN, ros2_client::log::Log::INFO);
 
+    // A stderr line as rcutils writes it: `[SEVERITY] [stamp] [logger]: message`; its severity.
+    let severity = |log: &str, text: &str| {
+        log.lines()
+            .find(|l| l.contains(&format!("] [slosh]: {text}")))
+            .and_then(|l| l.strip_prefix('[')?.split(']').next().map(String::from))
+    };
+
     let (log, rosout) = run(53, &[]);
-    for text in [
-        "] parameters ",
-        "] no motion sample was accepted",
-        "] stopping at t = ",
-    ] {
-        assert!(
-            log.contains(text),
-            "`{text}` missing from the default log:\n{log}"
-        );
-    }
+    assert_eq!(severity(&log, "parameters "), Some("INFO".into()), "{log}");
+    assert_eq!(
+        severity(&log, "no motion sample was accepted"),
+        Some("WARN".into()),
+        "{log}"
+    );
+    assert_eq!(
+        severity(&log, "stopping at t = "),
+        Some("INFO".into()),
+        "{log}"
+    );
     assert_eq!(
         said(&rosout, "no motion sample was accepted"),
         Some(warn),
@@ -1427,9 +1435,17 @@ fn the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout() {
 
     // Warnings and worse only, on both outputs.
     let (log, rosout) = run(54, &["--log-level", "WARN"]);
-    assert!(log.contains("] no motion sample was accepted"), "{log}");
-    for text in ["] parameters ", "] stopping at t = "] {
-        assert!(!log.contains(text), "`{text}` said below the level:\n{log}");
+    assert_eq!(
+        severity(&log, "no motion sample was accepted"),
+        Some("WARN".into()),
+        "{log}"
+    );
+    for text in ["parameters ", "stopping at t = "] {
+        assert_eq!(
+            severity(&log, text),
+            None,
+            "`{text}` said below the level:\n{log}"
+        );
     }
     assert_eq!(
         said(&rosout, "no motion sample was accepted"),
@@ -1450,10 +1466,14 @@ fn the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout() {
             "--disable-stdout-logs",
         ],
     );
-    assert!(!log.contains("[/slosh]"), "{log}");
+    assert!(!log.contains("[slosh]"), "{log}");
     assert!(rosout.is_empty(), "{rosout:?}");
     let (log, rosout) = run(56, &["--disable-rosout-logs"]);
-    assert!(log.contains("] stopping at t = "), "{log}");
+    assert_eq!(
+        severity(&log, "stopping at t = "),
+        Some("INFO".into()),
+        "{log}"
+    );
     assert!(rosout.is_empty(), "{rosout:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -47,7 +47,7 @@ enum Command {
     BenchTransport(bench_transport::Args),
     /// Work on recorded bags.
     Bag(bag::Args),
-    /// Run as a ROS 2 node: `slosh node --ros-args --params-file CASE.yaml [-p name:=value] [-r from:=to]`.
+    /// Run as a ROS 2 node: `slosh node --ros-args --params-file CASE.yaml [-p name:=value] [-r from:=to] [--log-level LEVEL]`.
     Node(node::Args),
     /// Publish synthetic vessel motion (the config's `motion.*`) as nav_msgs/Odometry on `motion/odom`.
     Motion(motion::Args),

@@ -1,7 +1,8 @@
 //! The log of `slosh node` and `slosh motion` as rcl's arguments set it: `--log-level LEVEL` (every logger)
 //! or `--log-level NAME:=LEVEL` (the logger of that name: a node's is its namespace and name joined by dots,
 //! `ship1.slosh`), `--disable-stdout-logs` (nothing on stderr) and `--disable-rosout-logs` (nothing on
-//! `/rosout`). A message below the level goes nowhere.
+//! `/rosout`). A message below the level goes nowhere. On stderr a message reads as rcutils' default console
+//! format has it: `[WARN] [1733500000.123456789] [ship1.slosh]: message`.
 
 use super::args::{ArgError, Names, RosArgs};
 pub use ros2_client::ros2::LogLevel;
@@ -23,8 +24,8 @@ pub fn parse_level(s: &str) -> Result<LogLevel, ArgError> {
 /// Where a process's messages go, and from which level.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Logger {
-    /// What each stderr line starts with.
-    prefix: String,
+    /// The logger's name, as rcl names a node's: `ship1.slosh`.
+    name: String,
     /// The least severe level said.
     level: LogLevel,
     stderr: bool,
@@ -33,8 +34,8 @@ pub struct Logger {
 
 impl Logger {
     /// The logger of the node `names` names, set by `args`: its own `NAME:=LEVEL` wins over a plain level;
-    /// info when neither is given. `prefix` starts each stderr line (`"[/ship1/slosh] "`).
-    pub fn new(args: &RosArgs, names: &Names, prefix: &str) -> Self {
+    /// info when neither is given.
+    pub fn new(args: &RosArgs, names: &Names) -> Self {
         let own = names.logger_name();
         let named = args
             .log_levels
@@ -43,7 +44,7 @@ impl Logger {
             .find(|(n, _)| n.as_deref() == Some(own.as_str()));
         let plain = args.log_levels.iter().rev().find(|(n, _)| n.is_none());
         Self {
-            prefix: prefix.to_string(),
+            name: own,
             level: named.or(plain).map_or(LogLevel::Info, |(_, l)| *l),
             stderr: !args.disable_stdout_logs,
             rosout: !args.disable_rosout_logs,
@@ -68,8 +69,26 @@ impl Logger {
     /// Writes `msg` on stderr if `level` is said there.
     pub fn say(&self, level: LogLevel, msg: &str) {
         if self.stderr && self.enabled(level) {
-            eprintln!("{}{msg}", self.prefix);
+            eprintln!("{}", self.line(level, msg, std::time::SystemTime::now()));
         }
+    }
+
+    /// `msg` as a console line, stamped `at`.
+    fn line(&self, level: LogLevel, msg: &str, at: std::time::SystemTime) -> String {
+        let since = at.duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+        let severity = match level {
+            LogLevel::Debug => "DEBUG",
+            LogLevel::Info => "INFO",
+            LogLevel::Warn => "WARN",
+            LogLevel::Error => "ERROR",
+            LogLevel::Fatal => "FATAL",
+        };
+        format!(
+            "[{severity}] [{}.{:09}] [{}]: {msg}",
+            since.as_secs(),
+            since.subsec_nanos(),
+            self.name
+        )
     }
 }
 
@@ -82,7 +101,7 @@ mod tests {
         let args: Vec<String> = a.split_whitespace().map(String::from).collect();
         let (_, r) = parse(&args).unwrap();
         let names = Names::new(&r, "slosh").unwrap();
-        Logger::new(&r, &names, "[/ship1/slosh] ")
+        Logger::new(&r, &names)
     }
 
     #[test]
@@ -106,6 +125,19 @@ mod tests {
         assert!(!l.enabled(LogLevel::Error));
         // The last of two plain levels counts, as in rcl.
         assert!(logger("--ros-args --log-level error --log-level info").enabled(LogLevel::Info));
+    }
+
+    #[test]
+    fn a_line_reads_as_rcutils_writes_it() {
+        let at = std::time::UNIX_EPOCH + std::time::Duration::new(1_733_500_000, 1_234);
+        let l = logger("--ros-args -r __ns:=/ship1");
+        assert_eq!(
+            l.line(LogLevel::Warn, "holding the last pose", at),
+            "[WARN] [1733500000.000001234] [ship1.slosh]: holding the last pose"
+        );
+        assert!(logger("--ros-args")
+            .line(LogLevel::Info, "x", at)
+            .starts_with("[INFO] [1733500000.000001234] [slosh]: "));
     }
 
     #[test]

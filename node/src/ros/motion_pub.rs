@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 pub fn run(ros: &RosArgs, config: &str, opts: &MotionOptions) -> anyhow::Result<()> {
     let (cfg, motion) = checked_motion(config, &ros.params, opts)?;
     let names = Names::new(ros, "slosh_motion")?;
-    let log = Logger::new(ros, &names, "slosh motion: ");
+    let log = Logger::new(ros, &names);
     let stop = crate::signals::shutdown_flag()?;
     let context = super::context()?;
     let mut node = context

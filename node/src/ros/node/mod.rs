@@ -83,7 +83,7 @@ pub fn run(
     start::check_settings(&cfg)?;
     // Before the resolution trials, so that a signal during them stops the node cleanly too.
     let stop = crate::signals::shutdown_flag()?;
-    let logger = Logger::new(ros, &names, &format!("[{}] ", names.node_fqn()));
+    let logger = Logger::new(ros, &names);
     let Some(resolution) = start::resolution(&cfg, &logger, &stop)? else {
         return Ok(());
     };

@@ -146,7 +146,7 @@ pub(super) fn resolution(
         say(&format!("realtime.auto_resolution: {why}"));
     }
     if let Some(w) = &choice.accuracy_warning {
-        warn(&format!("warning: realtime.auto_resolution: {w}"));
+        warn(&format!("realtime.auto_resolution: {w}"));
     }
     Ok(Some(Resolution {
         particle_spacing: Some(choice.particle_spacing),
