@@ -1360,13 +1360,13 @@ fn the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout() {
     let (dir, case) = common::case_dir("ros-log-level", "");
     // A node that never gets motion: it says its parameters (info), at the end that its recording holds no
     // simulation (warn), then that it stops (info). /rosout is read by Cyclone DDS, a third-party reader.
-    let run = |domain: u16, extra: &[&str]| -> (String, Vec<(u8, String)>) {
+    let run = |domain: u16, topic: &str, extra: &[&str]| -> (String, Vec<(u8, String, String)>) {
         let bag = dir.join(format!("bag{domain}"));
         let record = format!("record.path:={}", bag.display());
         let mut args = vec!["-p", &record];
         args.extend_from_slice(extra);
         let (_ctx, node) = common::participant(domain, "e2e_log");
-        let proc = logged_node(&node, &case, &args, domain, &["/motion/odom"]);
+        let proc = logged_node(&node, &case, &args, domain, &[topic]);
         let mut reader = Command::new(common::python())
             .arg(concat!(
                 env!("CARGO_MANIFEST_DIR"),
@@ -1389,6 +1389,16 @@ fn the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout() {
         let out = reader.wait_with_output().unwrap();
         assert!(out.status.success(), "the /rosout reader failed");
         let got: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        // Each message names where in the node it was said, not the logger's own file.
+        for m in got.as_array().unwrap() {
+            let file = m["file"].as_str().unwrap();
+            assert!(
+                file.ends_with(".rs")
+                    && !file.ends_with("logging.rs")
+                    && m["line"].as_u64() > Some(0),
+                "{m}"
+            );
+        }
         let rosout = got
             .as_array()
             .unwrap()
@@ -1396,68 +1406,75 @@ fn the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout() {
             .map(|m| {
                 (
                     m["level"].as_u64().unwrap() as u8,
+                    m["name"].as_str().unwrap().to_string(),
                     m["msg"].as_str().unwrap().to_string(),
                 )
             })
             .collect();
         (log, rosout)
     };
-    let said = |out: &[(u8, String)], text: &str| {
-        out.iter().find(|(_, m)| m.contains(text)).map(|(l, _)| *l)
+    // What /rosout had of a message: its level and logger name.
+    let said = |out: &[(u8, String, String)], text: &str| {
+        out.iter()
+            .find(|(_, _, m)| m.contains(text))
+            .map(|(l, n, _)| (*l, n.clone()))
     };
     let (warn, info) = (ros2_client::log::Log::WARN, ros2_client::log::Log::INFO);
-
-    // A stderr line as rcutils writes it: `[SEVERITY] [stamp] [logger]: message`; its severity.
-    let severity = |log: &str, text: &str| {
+    // A stderr line as rcutils writes it, `[SEVERITY] [stamp] [logger]: message`: its severity.
+    let severity = |log: &str, logger: &str, text: &str| {
         log.lines()
-            .find(|l| l.contains(&format!("] [slosh]: {text}")))
+            .find(|l| l.contains(&format!("] [{logger}]: {text}")))
             .and_then(|l| l.strip_prefix('[')?.split(']').next().map(String::from))
     };
 
-    let (log, rosout) = run(53, &[]);
-    assert_eq!(severity(&log, "parameters "), Some("INFO".into()), "{log}");
+    // In a namespace: the logger is `ship1.slosh`, on stderr and on /rosout.
+    let (log, rosout) = run(53, "/ship1/motion/odom", &["-r", "__ns:=/ship1"]);
+    let ship1 = |text: &str| severity(&log, "ship1.slosh", text);
+    assert_eq!(ship1("parameters "), Some("INFO".into()), "{log}");
     assert_eq!(
-        severity(&log, "no motion sample was accepted"),
+        ship1("no motion sample was accepted"),
         Some("WARN".into()),
         "{log}"
     );
-    assert_eq!(
-        severity(&log, "stopping at t = "),
-        Some("INFO".into()),
-        "{log}"
-    );
+    assert_eq!(ship1("stopping at t = "), Some("INFO".into()), "{log}");
+    let name = String::from("ship1.slosh");
     assert_eq!(
         said(&rosout, "no motion sample was accepted"),
-        Some(warn),
+        Some((warn, name.clone())),
         "{rosout:?}"
     );
-    assert_eq!(said(&rosout, "stopping at t = "), Some(info), "{rosout:?}");
+    assert_eq!(
+        said(&rosout, "stopping at t = "),
+        Some((info, name)),
+        "{rosout:?}"
+    );
 
     // Warnings and worse only, on both outputs.
-    let (log, rosout) = run(54, &["--log-level", "WARN"]);
+    let (log, rosout) = run(54, "/motion/odom", &["--log-level", "WARN"]);
     assert_eq!(
-        severity(&log, "no motion sample was accepted"),
+        severity(&log, "slosh", "no motion sample was accepted"),
         Some("WARN".into()),
         "{log}"
     );
     for text in ["parameters ", "stopping at t = "] {
         assert_eq!(
-            severity(&log, text),
+            severity(&log, "slosh", text),
             None,
             "`{text}` said below the level:\n{log}"
         );
     }
     assert_eq!(
         said(&rosout, "no motion sample was accepted"),
-        Some(warn),
+        Some((warn, "slosh".into())),
         "{rosout:?}"
     );
-    assert!(rosout.iter().all(|(l, _)| *l >= warn), "{rosout:?}");
+    assert!(rosout.iter().all(|(l, _, _)| *l >= warn), "{rosout:?}");
 
     // The node's own logger at error wins over a plain debug; nothing on stderr at all, and with
     // --disable-rosout-logs nothing on /rosout either.
     let (log, rosout) = run(
         55,
+        "/motion/odom",
         &[
             "--log-level",
             "slosh:=error",
@@ -1468,9 +1485,9 @@ fn the_log_level_and_the_log_outputs_apply_to_stderr_and_rosout() {
     );
     assert!(!log.contains("[slosh]"), "{log}");
     assert!(rosout.is_empty(), "{rosout:?}");
-    let (log, rosout) = run(56, &["--disable-rosout-logs"]);
+    let (log, rosout) = run(56, "/motion/odom", &["--disable-rosout-logs"]);
     assert_eq!(
-        severity(&log, "stopping at t = "),
+        severity(&log, "slosh", "stopping at t = "),
         Some("INFO".into()),
         "{log}"
     );

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """A third-party reader of ``/rosout`` on Cyclone DDS (the DDS of rmw_cyclonedds): reads
 rcl_interfaces/Log from ``rt/rosout`` (reliable, transient local, as rcl's rosout) for a number of
-seconds and prints what came as one JSON list of ``{"level", "name", "msg"}``. It prints ``ready`` on
+seconds and prints what came as one JSON list of ``{"level", "name", "msg", "file", "line"}``. It prints ``ready`` on
 stderr once its reader is open.
 
     rosout_cyclonedds.py --domain 53 --seconds 6
@@ -49,7 +49,7 @@ def main():
     end = time.time() + a.seconds
     while time.time() < end:
         # A writer going away shows as an invalid sample (no data): skipped.
-        got += [{"level": s.level, "name": s.name, "msg": s.msg}
+        got += [{"level": s.level, "name": s.name, "msg": s.msg, "file": s.file, "line": s.line}
                 for s in reader.take(N=100) if isinstance(s, Log)]
         time.sleep(0.02)
     print(json.dumps(got))

@@ -2,7 +2,9 @@
 //! or `--log-level NAME:=LEVEL` (the logger of that name: a node's is its namespace and name joined by dots,
 //! `ship1.slosh`), `--disable-stdout-logs` (nothing on stderr) and `--disable-rosout-logs` (nothing on
 //! `/rosout`). A message below the level goes nowhere. On stderr a message reads as rcutils' default console
-//! format has it: `[WARN] [1733500000.123456789] [ship1.slosh]: message`.
+//! format has it: `[WARN] [1733500000.123456789] [ship1.slosh]: message`; on `/rosout` it carries the same
+//! logger name (so nodes of one name in different namespaces stay apart) and the file and line it was said
+//! at.
 
 use super::args::{ArgError, Names, RosArgs};
 pub use ros2_client::ros2::LogLevel;
@@ -64,6 +66,25 @@ impl Logger {
     /// Whether the node publishes on `/rosout` at all.
     pub fn rosout(&self) -> bool {
         self.rosout
+    }
+
+    /// Says `msg` on stderr and on `/rosout` from `node`, where `level` is said.
+    #[track_caller]
+    pub fn log(&self, node: &ros2_client::Node, level: LogLevel, msg: &str) {
+        self.say(level, msg);
+        if self.to_rosout(level) {
+            let at = std::panic::Location::caller();
+            ros2_client::rosout::RosoutRaw::rosout_raw(
+                node,
+                ros2_client::builtin_interfaces::Time::now(),
+                level,
+                &self.name,
+                msg,
+                at.file(),
+                "",
+                at.line(),
+            );
+        }
     }
 
     /// Writes `msg` on stderr if `level` is said there.

@@ -256,11 +256,9 @@ impl LiveNode<'_> {
     }
 
     /// Says `msg` on stderr and on `/rosout`, as far as `--log-level` and the log's outputs let it.
+    #[track_caller]
     fn log(&self, level: ros2_client::ros2::LogLevel, msg: &str) {
-        self.logger.say(level, msg);
-        if self.logger.to_rosout(level) {
-            ros2_client::rosout!(self.ends.node, level, "{}", msg);
-        }
+        self.logger.log(&self.ends.node, level, msg);
     }
 
     /// The motion of a fresh start (after a reset, a resume or a new time base).

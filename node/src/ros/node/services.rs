@@ -36,10 +36,7 @@ impl LiveNode<'_> {
         ends.srv
             .parameters
             .serve(&mut self.table, &mut self.live, &name, |m| {
-                logger.say(LogLevel::Info, m);
-                if logger.to_rosout(LogLevel::Info) {
-                    ros2_client::rosout!(*node, LogLevel::Info, "{}", m);
-                }
+                logger.log(node, LogLevel::Info, m)
             })?;
         if self.live != before {
             let t = self.sim.time();
