@@ -80,16 +80,7 @@ pub fn parse(args: &[String]) -> Result<(Vec<String>, RosArgs), ArgError> {
                 }
                 "--log-level" => {
                     let v = next(&mut i, a)?;
-                    let level = match v.split_once(":=") {
-                        Some(("", _)) => {
-                            return Err(ArgError(format!(
-                                "`--log-level {v}`: expected LEVEL or LOGGER:=LEVEL"
-                            )))
-                        }
-                        Some((name, l)) => (Some(name.to_string()), super::logging::parse_level(l)?),
-                        None => (None, super::logging::parse_level(&v)?),
-                    };
-                    out.log_levels.push(level);
+                    out.log_levels.push(super::logging::parse_level(&v)?);
                 }
                 "-e" | "--enclave" => {
                     next(&mut i, a)?;

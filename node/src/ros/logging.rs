@@ -9,17 +9,26 @@
 use super::args::{ArgError, Names, RosArgs};
 pub use ros2_client::ros2::LogLevel;
 
-/// Parses a severity as rcutils does: any case, `warning` for `warn`.
-pub fn parse_level(s: &str) -> Result<LogLevel, ArgError> {
-    match s.to_ascii_lowercase().as_str() {
-        "debug" => Ok(LogLevel::Debug),
-        "info" => Ok(LogLevel::Info),
-        "warn" | "warning" => Ok(LogLevel::Warn),
-        "error" => Ok(LogLevel::Error),
-        "fatal" => Ok(LogLevel::Fatal),
-        _ => Err(ArgError(format!(
-            "`--log-level {s}`: expected debug, info, warn, error or fatal (any case), or LOGGER:=LEVEL"
+/// Parses `--log-level`'s value, `LEVEL` or `LOGGER:=LEVEL`, the level as rcutils reads one: any case,
+/// `warning` for `warn`.
+pub fn parse_level(v: &str) -> Result<(Option<String>, LogLevel), ArgError> {
+    let (name, level) = match v.split_once(":=") {
+        Some((name, level)) => (Some(name), level),
+        None => (None, v),
+    };
+    let level = match level.to_ascii_lowercase().as_str() {
+        "debug" => Some(LogLevel::Debug),
+        "info" => Some(LogLevel::Info),
+        "warn" | "warning" => Some(LogLevel::Warn),
+        "error" => Some(LogLevel::Error),
+        "fatal" => Some(LogLevel::Fatal),
+        _ => None,
+    };
+    match (name, level) {
+        (Some(""), _) | (_, None) => Err(ArgError(format!(
+            "`--log-level {v}`: expected LEVEL or LOGGER:=LEVEL, the level debug, info, warn, error or fatal (any case)"
         ))),
+        (name, Some(level)) => Ok((name.map(String::from), level)),
     }
 }
 
@@ -169,10 +178,9 @@ mod tests {
         ] {
             let args: Vec<String> = a.split_whitespace().map(String::from).collect();
             let e = parse(&args).unwrap_err().to_string();
-            assert!(
-                e.contains("expected debug, info, warn, error or fatal"),
-                "{e}"
-            );
+            // The whole value named, with what it may be.
+            assert!(e.contains("debug, info, warn, error or fatal"), "{e}");
+            assert!(e.contains(a.trim_start_matches("--ros-args ")), "{e}");
         }
         let args: Vec<String> = ["--ros-args", "--log-level", ":=info"]
             .map(String::from)
