@@ -494,10 +494,10 @@ fn spheric10_sensor1_at_4mm() {
     );
 }
 
-/// The same at 2 mm, WCSPH's second resolution. Not in the validation command: it takes 35-60 minutes on two
+/// The same at 2 mm, WCSPH's second resolution. Not in the validation command: it takes 30-60 minutes on two
 /// cores. Run it by name with `--ignored` (see the manual's page).
 #[test]
-#[ignore = "35-60 minutes on two cores; run by name with --ignored"]
+#[ignore = "30-60 minutes on two cores; run by name with --ignored"]
 fn spheric10_sensor1_at_2mm() {
     spheric10(
         &["solver.boundary.method=mirror"],
