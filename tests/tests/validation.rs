@@ -258,6 +258,13 @@ fn interp(t: &[f64], y: &[f64], x: f64) -> f64 {
     y[i - 1] + w * (y[i] - y[i - 1])
 }
 
+/// A built-in case with overrides, built and ready to step.
+fn simulation(case: &str, overrides: &[&str]) -> Box<dyn sph::Solver> {
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let cfg = config::load(case, &o).unwrap();
+    sph::build(cfg.sim_params().unwrap()).unwrap()
+}
+
 /// Runs a built-in case with overrides under `motion`, observing it every `every` s up to `t_end`.
 fn observe(
     case: &str,
@@ -266,9 +273,7 @@ fn observe(
     t_end: f64,
     every: f64,
 ) -> Vec<Observation> {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let cfg = config::load(case, &o).unwrap();
-    let mut sim = sph::build(cfg.sim_params().unwrap()).unwrap();
+    let mut sim = simulation(case, overrides);
     let mut out = vec![];
     let mut k = 0;
     while sim.time() < t_end {
@@ -527,9 +532,7 @@ fn spheric10_sensor(
     t_end: f64,
     fine: impl Fn(f64) -> bool,
 ) -> (Vec<f64>, Vec<f64>, (Vec<f64>, Vec<f64>)) {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let cfg = config::load("spheric10", &o).unwrap();
-    let mut sim = sph::build(cfg.sim_params().unwrap()).unwrap();
+    let mut sim = simulation("spheric10", overrides);
     let every = 0.002;
     let (mut t, mut p, mut tf, mut pf) = (vec![], vec![], vec![], vec![]);
     let mut k = 0;
@@ -599,15 +602,13 @@ fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str) {
         .unzip();
     let legend = format!("slosh ({label})");
     // Drawn: the 2 ms samples, and near the impacts the samples at the experiment's rate.
-    let (mut td, mut pd): (Vec<f64>, Vec<f64>) = (t.iter().zip(&p))
+    let mut drawn: Vec<(f64, f64)> = (t.iter().zip(&p))
         .filter(|(x, _)| !near_an_impact(**x))
+        .chain(ts_fine.iter().zip(&ps_fine))
         .map(|(x, y)| (*x, *y))
-        .unzip();
-    td.extend(&ts_fine);
-    pd.extend(&ps_fine);
-    let mut order: Vec<usize> = (0..td.len()).collect();
-    order.sort_by(|&i, &j| td[i].total_cmp(&td[j]));
-    let (td, pd): (Vec<f64>, Vec<f64>) = order.iter().map(|&i| (td[i], pd[i])).unzip();
+        .collect();
+    drawn.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (td, pd): (Vec<f64>, Vec<f64>) = drawn.into_iter().unzip();
     figure(
         name,
         "SPHERIC Test 10 (water, low fill): pressure at sensor 1",
