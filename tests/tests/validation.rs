@@ -562,7 +562,8 @@ fn spheric10_sensor(
 /// `overrides`; draws the figure `name`. The first three impacts come within 0.1 s of the measured ones and
 /// the slow pressure before the first and after it within 15 % (25 % at 8 mm); the table also shows the
 /// targets: impacts within 30 ms, their peaks inside the repeats' mean ± 2σ, the slow pressure between
-/// impacts within 15 %.
+/// impacts within 15 %; and prints each slow-pressure window against the record less the level the record
+/// reads as the sensor dries after it ([`spheric10_level_as_it_dries`]).
 /// The sensor is read on the wall's face (the case's sensor sits on it), as the flush transducer reads it.
 fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str) {
     let started = std::time::Instant::now();
@@ -689,19 +690,62 @@ fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str) {
                 &format!("± {:.0} %", bound * 100.0),
                 Some((ms - me).abs() < bound * me),
             );
-            if bound <= 0.15 {
-                continue;
-            }
         }
-        r.target(
-            &format!("{quantity}, against the target"),
-            format!("{:+.0} %", (ms / me - 1.0) * 100.0),
-            format!("{me:.0} Pa"),
-            "± 15 %",
-            (ms - me).abs() <= 0.15 * me,
+        if hi > 3.0 || bound > 0.15 {
+            r.target(
+                &format!("{quantity}, against the target"),
+                format!("{:+.0} %", (ms / me - 1.0) * 100.0),
+                format!("{me:.0} Pa"),
+                "± 15 %",
+                (ms - me).abs() <= 0.15 * me,
+            );
+        }
+        // The record's zero drifts by up to −250 Pa while the sensor is dry (see the manual's page): its
+        // level as the water leaves the sensor, and the window's mean with that level taken as the zero.
+        let (dry, level) = spheric10_level_as_it_dries(&exp, hi);
+        let zeroed = me - level;
+        r.row(
+            &format!("{quantity}, against the record less its level as it dries"),
+            format!("{:+.0} %", (ms / zeroed - 1.0) * 100.0),
+            format!(
+                "{zeroed:.0} Pa (level {level:.0} Pa at {dry:.2}-{:.2} s)",
+                dry + 0.1
+            ),
+            "printed, not asserted",
+            None,
         );
     }
     r.publish_and_check();
+}
+
+/// Where the record (`exp`: time, pressure rows sorted by time) turns dry after `after`: the first sample
+/// from which it stays below 100 Pa (under 1 cm of water) for 20 ms; and its median over the 0.1 s from
+/// there. Over that 0.1 s a gauge sensor in air reads 0, so the median is the record's zero as the water
+/// leaves the sensor.
+fn spheric10_level_as_it_dries(exp: &[Vec<f64>], after: f64) -> (f64, f64) {
+    let from = exp.partition_point(|r| r[0] < after);
+    let dry = (from..exp.len())
+        .find(|&i| {
+            exp[i..]
+                .iter()
+                .take_while(|r| r[0] < exp[i][0] + 0.02)
+                .all(|r| r[1] < 100.0)
+        })
+        .expect("the record dries after each impact");
+    let t0 = exp[dry][0];
+    let mut level: Vec<f64> = exp[dry..]
+        .iter()
+        .take_while(|r| r[0] <= t0 + 0.1)
+        .map(|r| r[1])
+        .collect();
+    level.sort_by(f64::total_cmp);
+    let n = level.len();
+    let median = if n % 2 == 1 {
+        level[n / 2]
+    } else {
+        0.5 * (level[n / 2 - 1] + level[n / 2])
+    };
+    (t0, median)
 }
 
 /// Akyildiz & Unal (2006), fig. 5, with the incompressible scheme at the case's 20 mm spacing, 0-10 s.
