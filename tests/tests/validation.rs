@@ -718,10 +718,10 @@ fn spheric10(overrides: &[&str], dp: f64, name: &str, label: &str) {
     r.publish_and_check();
 }
 
-/// Where the record (`exp`: time, pressure rows sorted by time) turns dry after `after`: the first sample
-/// from which it stays below 100 Pa (under 1 cm of water) for 20 ms; and its median over the 0.1 s from
-/// there. Over that 0.1 s a gauge sensor in air reads 0, so the median is the record's zero as the water
-/// leaves the sensor.
+/// Where the record (`exp`: time, pressure rows sorted by time) turns dry from `after` on: the first sample
+/// from which it stays below 100 Pa (under 1 cm of water, were its zero true) for 20 ms; and its median over
+/// the 0.1 s from there, where the water has left the sensor (splashes aside) and a gauge sensor in air
+/// reads 0: the record's level as the sensor dries.
 fn spheric10_level_as_it_dries(exp: &[Vec<f64>], after: f64) -> (f64, f64) {
     let from = exp.partition_point(|r| r[0] < after);
     let dry = (from..exp.len())
