@@ -748,6 +748,27 @@ fn spheric10_level_as_it_dries(exp: &[Vec<f64>], after: f64) -> (f64, f64) {
     (t0, median)
 }
 
+/// [`spheric10_level_as_it_dries`] on a made-up 1 kHz record: under water (600 Pa) until 1 s, then in air at
+/// −200 Pa with a splash to 300 Pa over 1.012–1.016 s and one to 500 Pa at 1.05 s. The sensor dries after the
+/// first splash (a 20 ms stretch below 100 Pa), and the second does not move the median.
+#[test]
+fn the_record_dries_after_its_last_splash_and_its_level_is_the_median_in_air() {
+    let exp: Vec<Vec<f64>> = (0..2000)
+        .map(|i| {
+            let p = match i {
+                ..1000 => 600.0,
+                1012..1017 => 300.0,
+                1050 => 500.0,
+                _ => -200.0,
+            };
+            vec![i as f64 * 1e-3, p]
+        })
+        .collect();
+    let (dry, level) = spheric10_level_as_it_dries(&exp, 0.5);
+    assert!((dry - 1.017).abs() < 1e-9, "dry from {dry} s");
+    assert_eq!(level, -200.0);
+}
+
 /// Akyildiz & Unal (2006), fig. 5, with the incompressible scheme at the case's 20 mm spacing, 0-10 s.
 #[test]
 fn akyildiz_2006_pitch_wall_pressure_dfsph() {
