@@ -1,14 +1,18 @@
-"""2D incremental projection SPH (ISPH) prototype with a surface mirror, for the sloshing free decay and
-forced sway of the seed tank. Not part of the product: it measures whether a projection scheme can meet the
-free-decay and forced-response bounds, as described in the manual's decisions page for the incompressible
-scheme ("The projection prototype's surface shift").
+"""2D projection SPH (ISPH) prototype with a surface mirror, for the sloshing free decay, forced sway and
+pitch of the seed tank and a dam break. Not part of the product: it measures whether a projection scheme can
+meet the free-decay and forced-response bounds, as described in the manual's decisions page for the
+incompressible scheme ("The projection prototype's surface shift" and the sections after it).
 
 The algorithm, one step:
-  1. images: mirror images across the tank's walls, and across the free surface's height function eta(x)
-     (pressure reversed there, so p = 0 on eta; velocity continued evenly);
-  2. predictor: v* = v + dt (g - a_tank - G p / rho + nu L v), G the corrected difference gradient;
+  1. images: mirror images across the tank's walls, and across the free surface (pressure reversed there,
+     so p = 0 on it; velocity continued evenly). The surface is a height function eta(x) (`--surface
+     height`) or, at each point, the tangent plane averaged from the nearby surface particles (`plane`);
+  2. predictor: v* = v + dt (f - G p / rho + nu L v), f the body force in the tank frame, G the corrected
+     difference gradient;
   3. pressure increment: L dp = rho/dt D v* + gamma (D G - L) p - beta rho (C - C0) / (C0 dt^2),
-     solved directly (L the Morris Laplacian, D the corrected divergence, C the kernel sum);
+     solved directly (L the Morris Laplacian, D the corrected divergence, C the kernel sum). With
+     `--pressure total` the whole pressure is solved for instead (no G p in v*), with -memory (D G - L) p
+     from the old pressure in place of the gamma term: memory 1 - gamma is the same scheme;
   4. corrector: v = v* - dt G dp / rho, p += dp;
   5. shifting: dr = -(A h |v| dt + B h^2) grad C, the top layer's mean along the surface subtracted, capped
      at 0.2 dp, the pressure carried along it to first order; x += dt v + dr.
@@ -17,6 +21,8 @@ Usage (numpy and scipy):
   python3 isph.py decay --layers 24 [--dp 0.008] [--jitter 0.1] [--cycles 5]
   python3 isph.py rest --layers 24 --jitter 0.1 [--tend 3]
   python3 isph.py sway --layers 24 --ratio 0.8 [--amp 0.004]
+  python3 isph.py pitch --layers 24 --ratio 0.8 [--amp 0.0087]
+  python3 isph.py dambreak --surface plane --wall-clearance 0.5 [--validation DIR]
 """
 import argparse
 
@@ -32,13 +38,31 @@ L_TANK = 0.8
 
 
 class Sim:
-    def __init__(s, layers, dp, dt=0.002, hfac=1.3, nu=1e-6, gamma=0.05, shift_a=2.0, shift_b=0.05,
-                 surface_sigma=1.5, beta=0.003, jitter=0.0, seed=1, sway_a=0.0, sway_w=0.0, ramp=0.0):
-        s.L, s.dp, s.h, s.dt = L_TANK, dp, hfac * dp, dt
+    def __init__(s, layers, dp, length=L_TANK, dt=0.002, hfac=1.3, nu=1e-6, gamma=0.05, shift_a=2.0, shift_b=0.05,
+                 surface_sigma=1.5, beta=0.003, jitter=0.0, seed=1, sway_a=0.0, pitch_a=0.0, forcing_w=0.0, ramp=0.0,
+                 surface='height', wall_clearance=0.05, pressure='increment', memory=0.95, memory_depth=0.0,
+                 memory_top=0.0):
+        s.L, s.dp, s.h, s.dt = length, dp, hfac * dp, dt
         s.rc = 2.0 * s.h
         s.nu, s.gamma, s.A, s.B, s.sigma, s.beta = nu, gamma, shift_a, shift_b, surface_sigma, beta
-        s.sway_a, s.sway_w, s.ramp = sway_a, sway_w, ramp
-        s.detmin, s.wc = 0.25, 0.05
+        assert sway_a == 0.0 or pitch_a == 0.0, "sway or pitch, not both"
+        s.sway_a, s.pitch_a, s.forcing_w, s.ramp = sway_a, pitch_a, forcing_w, ramp
+        s.detmin, s.wc = 0.25, wall_clearance
+        s.surface = surface
+        # pressure 'total': solve for the whole pressure, carrying `memory` of the old pressure's mismatch
+        # between D G and L (memory 1 - gamma is the increment scheme's), only deeper than memory_depth dp
+        s.total = pressure == 'total'
+        if s.total:
+            s.gamma = -memory
+        s.memory_depth = memory_depth
+        s.memory_top = memory_top  # the memory carried above memory_depth
+        # tangent-plane surface: a particle whose kernel sum (liquid and wall images) is below surf_thr of the
+        # lattice's is a surface particle; points and normals are averaged over plane_sigma dp; the surface is
+        # at least dmin dp above a point; an image closer than img_clear dp to a particle is dropped; a particle
+        # whose kernel sum with images is below splash_thr of the lattice's keeps p = 0
+        s.surf_thr, s.plane_sigma, s.dmin, s.img_clear, s.splash_thr = 0.88, 1.0, 0.5, 0.6, 0.8
+        k = np.arange(-4, 5) * dp
+        KX, KZ = np.meshgrid(k, k)
         nx = int(round(s.L / dp))
         X, Z = np.meshgrid((np.arange(nx) + 0.5) * dp, (np.arange(layers) + 0.5) * dp)
         s.x = np.stack([X.ravel(), Z.ravel()], 1)
@@ -53,9 +77,10 @@ class Sim:
         s.p = RHO * G * np.maximum(s.depth - s.x[:, 1], 0.0)
         s.V = dp * dp
         s.t = 0.0
-        s.acc = 0.0
+        s.body = np.tile([0.0, -G], (s.n, 1))
         s.c0 = None
         s.alpha = 7.0 / (4.0 * np.pi * s.h ** 2)
+        s.cint = s.V * s.w(np.hypot(KX, KZ)).sum()
 
     # Wendland C2 kernel (2D)
     def dwdr(s, r):
@@ -105,6 +130,58 @@ class Sim:
         xr = np.where(xq < 0, -xq, np.where(xq > s.L, 2 * s.L - xq, xq))
         return np.interp(xr, cen, sm)
 
+    def height_images(s, allx):
+        """Images across the height function: every point within 2h below eta(x)."""
+        eta = s.height(allx[:, 0])
+        s.depth_below = eta[:s.n] - s.x[:, 1]
+        cand = np.nonzero(allx[:, 1] > eta - s.rc)[0]
+        return cand, np.stack([allx[cand, 0], 2 * eta[cand] - allx[cand, 1]], 1)
+
+    def plane_images(s, allx):
+        """Images across each point's tangent plane: the Gaussian-weighted mean, over the surface particles
+        (and their wall images) within 2h, of the surface points x + n dp/2 and of the smoothed normals."""
+        d = cKDTree(s.x).sparse_distance_matrix(cKDTree(allx), s.rc, output_type='ndarray')
+        a, b, r = d['i'], d['j'], d['v']
+        keep = (a != b) & (r > 1e-12)
+        a, b, r = a[keep], b[keep], r[keep]
+        gw = (s.dwdr(r) / r)[:, None] * (s.x[a] - allx[b])
+        gc = np.stack([np.bincount(a, s.V * gw[:, i], minlength=s.n) for i in range(2)], 1)
+        ks = np.bincount(a, s.V * s.w(r), minlength=s.n) + s.V * s.w(0.0)
+        gn = np.linalg.norm(gc, axis=1)
+        nrm = -gc / np.maximum(gn, 1e-30)[:, None]
+        nrm[gn < 1e-6 / s.h] = [0.0, 1.0]
+        sidx = np.nonzero((ks < s.surf_thr * s.cint)[s.par])[0]
+        sx = allx[sidx]
+        sn = nrm[s.par[sidx]].copy()
+        sn[s.flipx[sidx], 0] *= -1
+        sn[s.flipz[sidx], 1] *= -1
+        sg = s.plane_sigma * s.dp
+        st = cKDTree(sx)
+        dd = st.sparse_distance_matrix(st, s.rc, output_type='ndarray')
+        wgt = np.exp(-0.5 * (dd['v'] / sg) ** 2)
+        ns = np.stack([np.bincount(dd['i'], wgt * sn[dd['j'], k], minlength=len(sx)) for k in range(2)], 1)
+        ns /= np.maximum(np.linalg.norm(ns, axis=1), 1e-30)[:, None]
+        q = sx + 0.5 * s.dp * ns
+        d = cKDTree(allx).sparse_distance_matrix(st, s.rc, output_type='ndarray')
+        i, j = d['i'], d['j']
+        wgt = np.exp(-0.5 * (d['v'] / sg) ** 2)
+        wsum = np.bincount(i, wgt, minlength=s.nw)
+        has = wsum > 0
+        qi = np.stack([np.bincount(i, wgt * q[j, k], minlength=s.nw) for k in range(2)], 1)
+        ni = np.stack([np.bincount(i, wgt * ns[j, k], minlength=s.nw) for k in range(2)], 1)
+        qi[has] /= wsum[has, None]
+        ni[has] /= np.maximum(np.linalg.norm(ni[has], axis=1), 1e-30)[:, None]
+        dist = np.full(s.nw, np.inf)
+        dist[has] = np.einsum('pi,pi->p', qi[has] - allx[has], ni[has])
+        dist = np.maximum(dist, s.dmin * s.dp)
+        s.depth_below = dist[:s.n]
+        cand = np.nonzero(dist < s.rc)[0]
+        img = allx[cand] + 2 * dist[cand, None] * ni[cand]
+        # an image that lands among the liquid (its plane taken from a surface elsewhere) is dropped
+        gap, _ = cKDTree(s.x).query(img)
+        ok = gap > s.img_clear * s.dp
+        return cand[ok], img[ok]
+
     def neighbours(s):
         gx, gpar, gfx, gfz = s.wall_images()
         allx = np.concatenate([s.x, gx])
@@ -112,12 +189,9 @@ class Sim:
         s.flipx = np.concatenate([np.zeros(s.n, bool), gfx])
         s.flipz = np.concatenate([np.zeros(s.n, bool), gfz])
         s.nw = len(allx)
-        # surface images of the particles and wall images within 2h of eta
-        eta = s.height(allx[:, 0])
-        s.depth_below = eta[:s.n] - s.x[:, 1]
-        cand = np.nonzero(allx[:, 1] > eta - s.rc)[0]
+        cand, img = s.height_images(allx) if s.surface == 'height' else s.plane_images(allx)
         s.src = cand
-        allx = np.concatenate([allx, np.stack([allx[cand, 0], 2 * eta[cand] - allx[cand, 1]], 1)])
+        allx = np.concatenate([allx, img])
         s.par = np.concatenate([s.par, s.par[cand]])
         s.flipx = np.concatenate([s.flipx, s.flipx[cand]])
         s.flipz = np.concatenate([s.flipz, s.flipz[cand]])
@@ -165,9 +239,9 @@ class Sim:
         nw = s.nw
         out = p[s.par[:nw]].copy()
         fz = s.flipz[:nw]
-        out[fz] += RHO * G * (s.x[s.par[:nw][fz], 1] - s.allx[:nw][fz, 1])
+        out[fz] += RHO * s.body[s.par[:nw][fz], 1] * (s.allx[:nw][fz, 1] - s.x[s.par[:nw][fz], 1])
         fx = s.flipx[:nw]
-        out[fx] += -RHO * s.acc * (s.allx[:nw][fx, 0] - s.x[s.par[:nw][fx], 0])
+        out[fx] += RHO * s.body[s.par[:nw][fx], 0] * (s.allx[:nw][fx, 0] - s.x[s.par[:nw][fx], 0])
         return np.concatenate([out, -out[s.src]])
 
     def grad(s, fall):
@@ -178,13 +252,31 @@ class Sim:
         dv = np.einsum('pi,pi->p', vall[s.b] - vall[s.a], s.cgw) * s.V
         return np.bincount(s.a, dv, minlength=s.n)
 
-    def tank_pos(s, t):
+    def motion(s, t):
+        """The forcing's time history per unit amplitude: sin wt under a half-cosine ramp."""
         r = 1.0 if t >= s.ramp else 0.5 * (1.0 - np.cos(np.pi * t / s.ramp))
-        return s.sway_a * r * np.sin(s.sway_w * t)
+        return r * np.sin(s.forcing_w * t)
+
+    def motion_rates(s, t):
+        """The motion's first and second time derivatives (central differences)."""
+        e = 1e-4
+        m0, mp, mm = s.motion(t), s.motion(t + e), s.motion(t - e)
+        return (mp - mm) / (2 * e), (mp - 2 * m0 + mm) / e ** 2
 
     def tank_acc(s, t):
-        e = 1e-4
-        return (s.tank_pos(t + e) - 2 * s.tank_pos(t) + s.tank_pos(t - e)) / e ** 2
+        return s.sway_a * s.motion_rates(t)[1] if s.sway_a > 0 else 0.0
+
+    def body_force(s, t):
+        """Force per unit mass on each particle in the tank frame: gravity, the sway's inertial force, and
+        the pitch's (theta about +y through the centre of the floor; positive theta turns the apparent
+        gravity towards +x): Euler -theta'' y x r, Coriolis -2 theta' y x v, centrifugal theta'^2 r."""
+        f = np.empty((s.n, 2))
+        th = s.pitch_a * s.motion(t)
+        thd, thdd = (s.pitch_a * d for d in s.motion_rates(t))
+        xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, 1]
+        f[:, 0] = G * np.sin(th) - s.tank_acc(t) - thdd * z - 2 * thd * s.v[:, 1] + thd ** 2 * xr
+        f[:, 1] = -G * np.cos(th) + thdd * xr + 2 * thd * s.v[:, 0] + thd ** 2 * z
+        return f
 
     def surface_shift(s, sh):
         """Subtract from the top layer's shift its Gaussian-weighted mean along the layer (both components;
@@ -196,6 +288,10 @@ class Sim:
         wm = np.exp(-0.5 * ((xn[:, None] + xn[None, :]) / sg) ** 2)
         wm += np.exp(-0.5 * ((2 * s.L - xn[:, None] - xn[None, :]) / sg) ** 2)
         wz = np.exp(-0.5 * ((dn[:, None] - dn[None, :]) / (0.5 * s.dp)) ** 2)
+        if s.surface == 'plane':
+            # the layer need not be a graph of x: neighbours along it are near in z too
+            zn = s.x[near, 1]
+            wz *= np.exp(-0.5 * ((zn[:, None] - zn[None, :]) / sg) ** 2)
         wgt = (wd + wm) * wz
         norm = wgt.sum(1)
         sh[near, 1] -= wgt @ sh[near, 1] / norm
@@ -203,18 +299,27 @@ class Sim:
 
     def step(s):
         dt, n = s.dt, s.n
-        s.acc = s.tank_acc(s.t + 0.5 * dt) if s.sway_a > 0 else 0.0
-        body = np.array([-s.acc, -G])
+        body = s.body = s.body_force(s.t + 0.5 * dt)
         s.neighbours()
         a, b = s.a, s.b
+        # splash: a particle with too few neighbours, images included, keeps p = 0
+        splash = s.ksum < s.splash_thr * s.cint
+        s.p[splash] = 0.0
         # predictor: body force, pressure, Morris viscosity with no-slip walls
         vall = s.image_vec(s.v, noslip=True)
         coef = 2.0 * s.V * s.fw / (s.r + 0.01 * s.h ** 2 / s.r)
         lapv = np.stack([np.bincount(a, coef * (vall[a, i] - vall[b, i]), minlength=n) for i in range(2)], 1)
         pall = s.image_p(s.p)
         gp = s.grad(pall)
-        vs = s.v + dt * (body - gp / RHO + s.nu * lapv)
-        rhs = RHO / dt * s.div(s.image_vec(vs))
+        if s.total:
+            # the whole pressure is solved for: the walls' images carry the predictor's body-force part
+            # unreflected, so that the hydrostatic pressure (continued across the walls) is the solution at rest
+            vs = s.v + dt * (body + s.nu * lapv)
+            vimg = s.image_vec(s.v + dt * s.nu * lapv) + dt * body[s.par]
+            rhs = RHO / dt * s.div(vimg)
+        else:
+            vs = s.v + dt * (body - gp / RHO + s.nu * lapv)
+            rhs = RHO / dt * s.div(s.image_vec(vs))
         if s.beta > 0:
             if s.c0 is None:
                 s.c0 = np.median(s.ksum)
@@ -228,15 +333,27 @@ class Sim:
         diag = np.bincount(a, c, minlength=n)
         A = sp.csr_matrix((np.concatenate([diag, -c * s.psign[b]]),
                            (np.concatenate([np.arange(n), a]), np.concatenate([np.arange(n), pb]))), shape=(n, n))
-        if s.gamma > 0:
+        if s.total:
+            # the images' pressure is affine in their parent's: the constant part goes to the right-hand side
+            rhs = rhs + np.bincount(a, c_all * s.image_p(np.zeros(n))[b], minlength=n)
+        if s.gamma != 0:
             # stabilisation of the collocated pressure: gamma (D G p - L p)
             e = body - gp / RHO
             dgp = -RHO * s.div(s.image_vec(e))
             lp = np.bincount(a, c_all * (pall[a] - pall[b]), minlength=n)
-            rhs = rhs + s.gamma * (dgp - lp)
+            gam = np.where(s.depth_below < s.memory_depth * s.dp, -s.memory_top, s.gamma)
+            rhs = rhs + gam * (dgp - lp)
+        splash |= np.abs(diag) <= 1e-9 * np.abs(diag).max()
+        if splash.any():
+            A = sp.diags((~splash).astype(float)) @ A + sp.diags(splash.astype(float))
+            rhs = np.where(splash, 0.0, rhs)
         dpres = spla.spsolve(A.tocsc(), rhs)
-        s.p = s.p + dpres
-        s.v = vs - dt / RHO * s.grad(dpres[s.par] * s.psign)
+        if s.total:
+            s.p = dpres
+            s.v = vs - dt / RHO * s.grad(s.image_p(s.p))
+        else:
+            s.p = s.p + dpres
+            s.v = vs - dt / RHO * s.grad(dpres[s.par] * s.psign)
         # shifting
         dx = dt * s.v
         gc = np.stack([np.bincount(a, s.V * s.gw[:, i], minlength=n) for i in range(2)], 1)
@@ -305,14 +422,100 @@ def faltinsen_sway_force(w, depth, mass, amp):
     return mass * amp * w ** 2 * (1 + total)
 
 
+def pitch_moment(w, depth, modes=400):
+    """Linear potential theory (Faltinsen & Timokha 2009): the liquid's moment about y on the tank, about the
+    centre of the floor, per unit breadth, coefficient of sin wt for a pitch theta_a sin wt (per unit
+    theta_a). The same series as the solver's sloshing::theory::Tank::pitch_moment."""
+    L, h, g = L_TANK, depth, G
+    c, w2 = h / 2.0, w * w
+    inertia = L * h ** 3 / 3.0 - h * L ** 3 / 12.0
+    surface = 0.0
+    for i in range(modes):
+        k = (2 * i + 1) * np.pi / L
+        wn2 = g * k * np.tanh(k * h)
+        e = -4.0 / (L * k * k)
+        bc = 8.0 / (L * k ** 3)
+        bs = bc * np.tanh(k * c)
+        a = (w2 * (h * e + bs) + g * e) / (wn2 - w2)
+        sech = 1.0 / np.cosh(k * h)
+        inertia += -4.0 * bc * (c / k - np.tanh(k * c) / (k * k)) + 4.0 * bs / (k * k)
+        inertia += -2.0 * a * (h * np.tanh(k * h) / k - (1.0 - sech) / (k * k)) + 2.0 * a * (1.0 - sech) / (k * k)
+        surface += -2.0 * a * np.tanh(k * h) / k
+    return RHO * (g * (L * h * h / 2.0 + surface) + w2 * inertia)
+
+
+def fit_forced(t, f, w, w1):
+    """Amplitude and phase (degrees, of the sin wt coefficient) of a response at w, fitted together with a
+    decaying free mode near w1."""
+    def res(q):
+        u = t - t[0]
+        return (q[0] * np.cos(w * t) + q[1] * np.sin(w * t)
+                + np.exp(-q[4] * u) * (q[2] * np.cos(q[5] * u) + q[3] * np.sin(q[5] * u)) - f)
+
+    q = least_squares(res, [0, 0, 0, 0, 0.01, w1]).x
+    return np.hypot(q[0], q[1]), np.degrees(np.arctan2(q[0], q[1]))
+
+
 def blew_up(s):
     speed = np.linalg.norm(s.v, axis=1)
     return not np.isfinite(speed).all() or speed.max() > 0.5
 
 
+def dam_break(n, tend, kw, validation, width=0.146):
+    """Koshizuka & Oka (1996): a column width wide and twice as high at the left end of a tank four widths
+    long. Prints the surge front (the furthest particle within 2 dp of the floor with three neighbours) against
+    T = t sqrt(2 g / width), beside the experiment and their MPS computation when the validation folder
+    (holding dambreak_front/koshizuka_oka_1996_*.csv) is given."""
+    dp = width / n
+    s = Sim(2, dp, length=4 * width, **kw)
+    X, Z = np.meshgrid((np.arange(n) + 0.5) * dp, (np.arange(2 * n) + 0.5) * dp)
+    s.x = np.stack([X.ravel(), Z.ravel()], 1)
+    s.n = len(s.x)
+    s.v = np.zeros_like(s.x)
+    s.p = RHO * G * (2 * width - s.x[:, 1])
+    s.depth = 2 * width
+    s.dt = 0.4 * s.h / (2 * np.sqrt(G * 2 * width))
+    s.neighbours()
+    scale = np.sqrt(2 * G / width)
+    ts, zs = [], []
+
+    def energy():
+        return np.sum(0.5 * np.sum(s.v ** 2, 1) + G * s.x[:, 1])
+
+    # the energy that can be lost: the column's potential energy above the level liquid's (depth width / 2)
+    e0, report = energy(), 1.0
+    e_free = e0 - s.n * G * width / 4
+    while s.t * scale < tend:
+        s.step()
+        if not np.isfinite(s.v).all():
+            print(f"blew up at T = {s.t * scale:.2f}")
+            break
+        if s.t * scale >= report:
+            speed = np.linalg.norm(s.v, axis=1)
+            print(f"T {s.t * scale:.1f}: energy lost {(e0 - energy()) / e_free * 100:.1f} % of the available, "
+                  f"fastest particle {speed.max():.2f} m/s, {np.sum(speed > 4.0)} faster than 4 m/s")
+            report += 1.0
+        own = s.b < s.n
+        count = np.bincount(s.a[own], minlength=s.n)
+        m = (s.x[:, 1] < 2 * dp) & (count >= 3)
+        ts.append(s.t * scale)
+        zs.append(s.x[m, 0].max() / width if m.any() else np.nan)
+    ts, zs = np.array(ts), np.array(zs)
+    for T in [0.4, 0.8, 1.2, 1.6, 2.0, 2.4, 2.8]:
+        if T <= ts[-1]:
+            line = f"T {T:.1f}: front Z/L {np.interp(T, ts, zs):.3f}"
+            if validation:
+                for name in ['experiment', 'mps']:
+                    ref = np.loadtxt(f"{validation}/dambreak_front/koshizuka_oka_1996_{name}.csv", delimiter=',',
+                                     skiprows=1)
+                    z = np.interp(T, ref[:, 0], ref[:, 1])
+                    line += f"; {name} {z:.3f} ({(np.interp(T, ts, zs) / z - 1) * 100:+.1f} %)"
+            print(line)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument('case', choices=['decay', 'rest', 'sway'])
+    ap.add_argument('case', choices=['decay', 'rest', 'sway', 'pitch', 'dambreak'])
     ap.add_argument('--layers', type=int, default=24)
     ap.add_argument('--dp', type=float, default=0.008)
     ap.add_argument('--jitter', type=float, default=0.0)
@@ -320,9 +523,28 @@ def main():
     ap.add_argument('--tend', type=float, default=3.0)
     ap.add_argument('--ratio', type=float, default=0.8)
     ap.add_argument('--amp', type=float, default=None)
+    ap.add_argument('--surface', choices=['height', 'plane'], default='height',
+                    help='free surface: a height function eta(x), or each point\'s tangent plane')
+    ap.add_argument('--wall-clearance', type=float, default=0.05,
+                    help='closest approach of a particle to a wall, in dp')
+    ap.add_argument('--pressure', choices=['increment', 'total'], default='increment',
+                    help='solve for the pressure increment (gamma stabilisation) or the whole pressure')
+    ap.add_argument('--memory', type=float, default=0.95,
+                    help='total: share of the old pressure\'s (D G - L) mismatch carried into the solve')
+    ap.add_argument('--memory-depth', type=float, default=0.0,
+                    help='total: carry it only for particles deeper than this (dp) below the surface')
+    ap.add_argument('--memory-top', type=float, default=0.0,
+                    help='total: the share carried above --memory-depth')
+    ap.add_argument('--column', type=int, default=25, help='dambreak: particles across the column')
+    ap.add_argument('--validation', default=None, help='dambreak: the validation data folder, for comparison')
     a = ap.parse_args()
+    kw = dict(surface=a.surface, wall_clearance=a.wall_clearance, pressure=a.pressure, memory=a.memory,
+              memory_depth=a.memory_depth, memory_top=a.memory_top)
+    if a.case == 'dambreak':
+        dam_break(a.column, a.tend, kw, a.validation)
+        return
     if a.case == 'decay':
-        s = Sim(a.layers, a.dp, jitter=a.jitter)
+        s = Sim(a.layers, a.dp, jitter=a.jitter, **kw)
         s.neighbours()
         T = s.start_first_mode(0.01 if a.amp is None else a.amp)
         ts, ys = [], []
@@ -340,7 +562,7 @@ def main():
             print(f"free decay: theory T {T:.4f} s; measured {per:.4f} s ({(per / T - 1) * 100:+.2f} %), "
                   f"damping ratio {z:.5f}")
     elif a.case == 'rest':
-        s = Sim(a.layers, a.dp, jitter=a.jitter)
+        s = Sim(a.layers, a.dp, jitter=a.jitter, **kw)
         s.neighbours()
         for i in range(1, int(round(a.tend / s.dt)) + 1):
             s.step()
@@ -351,39 +573,45 @@ def main():
                 speed = np.linalg.norm(s.v, axis=1)
                 print(f"t {s.t:.2f} s: mean speed {speed.mean():.2e} m/s, max {speed.max():.2e} m/s")
     else:
-        amp = 0.004 if a.amp is None else a.amp
+        pitch = a.case == 'pitch'
+        amp = (np.radians(0.5) if pitch else 0.004) if a.amp is None else a.amp
         w1 = first_mode(a.layers * a.dp)
         w = a.ratio * w1
         Tf, T1 = 2 * np.pi / w, 2 * np.pi / w1
         ramp = 2 * Tf
-        s = Sim(a.layers, a.dp, jitter=a.jitter, sway_a=amp, sway_w=w, ramp=ramp)
+        motion = dict(pitch_a=amp) if pitch else dict(sway_a=amp)
+        s = Sim(a.layers, a.dp, jitter=a.jitter, forcing_w=w, ramp=ramp, **motion, **kw)
         s.neighbours()
         mass = RHO * s.V * s.n
-        ts, P = [], []
+        ts, P, Ly, tb, Mb = [], [], [], [], []
         while s.t < ramp + max(5 * Tf, 6 * T1):
+            xb, zb = s.x[:, 0] - 0.5 * s.L, s.x[:, 1].copy()
             s.step()
             if blew_up(s):
                 print(f"blew up at {s.t:.3f} s")
                 return
+            # moments about the centre of the floor, y component of r x (.)
+            tb.append(s.t - 0.5 * s.dt)
+            Mb.append(RHO * s.V * np.sum(zb * s.body[:, 0] - xb * s.body[:, 1]))
+            xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, 1]
             ts.append(s.t)
             P.append(RHO * s.V * s.v[:, 0].sum())
-        ts, P = np.array(ts), np.array(P)
-        F = -(np.gradient(P, ts) + mass * np.array([s.tank_acc(t) for t in ts]))
+            Ly.append(RHO * s.V * np.sum(z * s.v[:, 0] - xr * s.v[:, 1]))
+        ts, P, Ly = np.array(ts), np.array(P), np.array(Ly)
+        if pitch:
+            # the liquid's moment on the tank: its body forces' moment less the rate of its angular momentum
+            resp = np.interp(ts, tb, Mb) - np.gradient(Ly, ts)
+            th = pitch_moment(w, a.layers * a.dp) * amp
+            what, unit = "moment per rotation", "N m/rad"
+        else:
+            resp = -(np.gradient(P, ts) + mass * np.array([s.tank_acc(t) for t in ts]))
+            th = faltinsen_sway_force(w, a.layers * a.dp, mass, amp)
+            what, unit = "force per displacement", "N/m"
         m = ts > ramp
-        t, f = ts[m], F[m]
-
-        def res(q):
-            u = t - t[0]
-            return (q[0] * np.cos(w * t) + q[1] * np.sin(w * t)
-                    + np.exp(-q[4] * u) * (q[2] * np.cos(q[5] * u) + q[3] * np.sin(q[5] * u)) - f)
-
-        q = least_squares(res, [0, 0, 0, 0, 0.01, w1]).x
-        got = np.hypot(q[0], q[1])
-        phase = np.degrees(np.arctan2(q[0], q[1]))
-        th = faltinsen_sway_force(w, a.layers * a.dp, mass, amp)
+        got, phase = fit_forced(ts[m], resp[m], w, w1)
         dph = (phase - (0.0 if th > 0 else 180.0) + 180) % 360 - 180
-        print(f"sway at {a.ratio} of the first mode: force per displacement {got / amp:.1f} N/m, theory "
-              f"{abs(th) / amp:.1f} N/m ({(got / abs(th) - 1) * 100:+.1f} %), phase {dph:+.1f} deg")
+        print(f"{a.case} at {a.ratio} of the first mode: {what} {got / amp:.1f} {unit}, theory "
+              f"{abs(th) / amp:.1f} {unit} ({(got / abs(th) - 1) * 100:+.1f} %), phase {dph:+.1f} deg")
 
 
 if __name__ == '__main__':
