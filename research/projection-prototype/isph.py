@@ -41,7 +41,7 @@ class Sim:
     def __init__(s, layers, dp, length=L_TANK, dt=0.002, hfac=1.3, nu=1e-6, gamma=0.05, shift_a=2.0, shift_b=0.05,
                  surface_sigma=1.5, beta=0.003, jitter=0.0, seed=1, sway_a=0.0, pitch_a=0.0, forcing_w=0.0, ramp=0.0,
                  surface='height', wall_clearance=0.05, pressure='increment', memory=0.95, memory_depth=0.0,
-                 memory_top=0.0):
+                 memory_top=0.0, memory_clip=0.0):
         s.L, s.dp, s.h, s.dt = length, dp, hfac * dp, dt
         s.rc = 2.0 * s.h
         s.nu, s.gamma, s.A, s.B, s.sigma, s.beta = nu, gamma, shift_a, shift_b, surface_sigma, beta
@@ -56,6 +56,7 @@ class Sim:
             s.gamma = -memory
         s.memory_depth = memory_depth
         s.memory_top = memory_top  # the memory carried above memory_depth
+        s.memory_clip = memory_clip  # each particle's memory term at most this many rho g / dp (0: no limit)
         # tangent-plane surface: a particle whose kernel sum (liquid and wall images) is below surf_thr of the
         # lattice's is a surface particle; points and normals are averaged over plane_sigma dp; the surface is
         # at least dmin dp above a point; an image closer than img_clear dp to a particle is dropped; a particle
@@ -342,7 +343,12 @@ class Sim:
             dgp = -RHO * s.div(s.image_vec(e))
             lp = np.bincount(a, c_all * (pall[a] - pall[b]), minlength=n)
             gam = np.where(s.depth_below < s.memory_depth * s.dp, -s.memory_top, s.gamma)
-            rhs = rhs + gam * (dgp - lp)
+            term = gam * (dgp - lp)
+            if s.memory_clip > 0:
+                # a pressure spike's memory is cut to what a smooth pressure needs
+                lim = s.memory_clip * RHO * G / s.dp
+                term = np.clip(term, -lim, lim)
+            rhs = rhs + term
         splash |= np.abs(diag) <= 1e-9 * np.abs(diag).max()
         if splash.any():
             A = sp.diags((~splash).astype(float)) @ A + sp.diags(splash.astype(float))
@@ -535,11 +541,13 @@ def main():
                     help='total: carry it only for particles deeper than this (dp) below the surface')
     ap.add_argument('--memory-top', type=float, default=0.0,
                     help='total: the share carried above --memory-depth')
+    ap.add_argument('--memory-clip', type=float, default=0.0,
+                    help='total: cut each particle\'s memory term to this many rho g / dp (0: no limit)')
     ap.add_argument('--column', type=int, default=25, help='dambreak: particles across the column')
     ap.add_argument('--validation', default=None, help='dambreak: the validation data folder, for comparison')
     a = ap.parse_args()
     kw = dict(surface=a.surface, wall_clearance=a.wall_clearance, pressure=a.pressure, memory=a.memory,
-              memory_depth=a.memory_depth, memory_top=a.memory_top)
+              memory_depth=a.memory_depth, memory_top=a.memory_top, memory_clip=a.memory_clip)
     if a.case == 'dambreak':
         dam_break(a.column, a.tend, kw, a.validation)
         return

@@ -137,6 +137,9 @@ def main():
                 if isinstance(s, types[k]):
                     got[k].append(s)
 
+    def header_time(h):
+        return h.stamp.sec + h.stamp.nanosec * 1e-9 - a.t0
+
     start = time.monotonic()
     # The node is on the graph once its diagnostics arrive; then give matching a moment.
     while not got["diagnostics"] or odom_w.get_publication_matched_status().current_count == 0:
@@ -188,7 +191,15 @@ def main():
             drain()
             time.sleep(0.002)
         if a.parameters and k == n // 2:
-            # Halfway: 10 Hz outputs from now on, and a spacing the running node cannot take.
+            # Halfway: 10 Hz outputs from now on, and a spacing the running node cannot take. The node runs in
+            # lockstep behind this input and may lag it on a loaded machine: first wait until its outputs reach
+            # within 0.1 s of this sample, so that the set lands at a known point of its time base.
+            caught_up = time.monotonic() + a.timeout
+            while not got["wrench"] or max(header_time(w.header) for w in got["wrench"]) < t - 0.1:
+                if time.monotonic() > caught_up:
+                    raise RuntimeError("the node's outputs never caught up with the input before the set")
+                drain()
+                time.sleep(0.01)
             res = svc.call("set_parameters", SetParametersRequest(parameters=[
                 Parameter(name="output_rate_hz", value=value(type=3, double_value=10.0)),
                 Parameter(name="particle_spacing", value=value(type=3, double_value=0.01))])).results
@@ -210,9 +221,6 @@ def main():
         drain()
         time.sleep(0.02)
 
-    def t_of(h):
-        return h.stamp.sec + h.stamp.nanosec * 1e-9 - a.t0
-
     w, p, pr, d = got["wrench"], got["probes"], got["pressures"], got["diagnostics"]
     c = got["particles"]
 
@@ -231,10 +239,10 @@ def main():
         "parameters": params,
         "counts": {k: len(v) for k, v in got.items()},
         "wrench_last": None if not w else {
-            "t": t_of(w[-1].header), "frame_id": w[-1].header.frame_id,
+            "t": header_time(w[-1].header), "frame_id": w[-1].header.frame_id,
             "force": [w[-1].wrench.force.x, w[-1].wrench.force.y, w[-1].wrench.force.z],
             "torque": [w[-1].wrench.torque.x, w[-1].wrench.torque.y, w[-1].wrench.torque.z]},
-        "wrench_times": [t_of(m.header) for m in w],
+        "wrench_times": [header_time(m.header) for m in w],
         "probes_last": None if not p else {
             "names": list(p[-1].names), "elevations": list(p[-1].elevations),
             "positions": [[q.x, q.y, q.z] for q in p[-1].positions]},
