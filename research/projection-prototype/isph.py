@@ -141,7 +141,8 @@ class Sim:
     def plane_images(s, allx):
         """Images across each point's tangent plane: the Gaussian-weighted mean, over the surface particles
         (and their wall images) within 2h, of the surface points x + n dp/2 and of the smoothed normals."""
-        d = cKDTree(s.x).sparse_distance_matrix(cKDTree(allx), s.rc, output_type='ndarray')
+        liquid = cKDTree(s.x)
+        d = liquid.sparse_distance_matrix(cKDTree(allx), s.rc, output_type='ndarray')
         a, b, r = d['i'], d['j'], d['v']
         keep = (a != b) & (r > 1e-12)
         a, b, r = a[keep], b[keep], r[keep]
@@ -179,7 +180,7 @@ class Sim:
         cand = np.nonzero(dist < s.rc)[0]
         img = allx[cand] + 2 * dist[cand, None] * ni[cand]
         # an image that lands among the liquid (its plane taken from a surface elsewhere) is dropped
-        gap, _ = cKDTree(s.x).query(img)
+        gap, _ = liquid.query(img)
         ok = gap > s.img_clear * s.dp
         return cand[ok], img[ok]
 
@@ -272,10 +273,10 @@ class Sim:
         the pitch's (theta about +y through the centre of the floor; positive theta turns the apparent
         gravity towards +x): Euler -theta'' y x r, Coriolis -2 theta' y x v, centrifugal theta'^2 r."""
         f = np.empty((s.n, 2))
-        th = s.pitch_a * s.motion(t)
-        thd, thdd = (s.pitch_a * d for d in s.motion_rates(t))
+        rate, accel = s.motion_rates(t)
+        th, thd, thdd = s.pitch_a * s.motion(t), s.pitch_a * rate, s.pitch_a * accel
         xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, 1]
-        f[:, 0] = G * np.sin(th) - s.tank_acc(t) - thdd * z - 2 * thd * s.v[:, 1] + thd ** 2 * xr
+        f[:, 0] = G * np.sin(th) - s.sway_a * accel - thdd * z - 2 * thd * s.v[:, 1] + thd ** 2 * xr
         f[:, 1] = -G * np.cos(th) + thdd * xr + 2 * thd * s.v[:, 0] + thd ** 2 * z
         return f
 
@@ -507,15 +508,18 @@ def dam_break(n, tend, kw, validation, width=0.146):
         ts.append(s.t * scale)
         zs.append(s.x[m, 0].max() / width if m.any() else np.nan)
     ts, zs = np.array(ts), np.array(zs)
+    refs = {}
+    if validation:
+        for name in ['experiment', 'mps']:
+            refs[name] = np.loadtxt(f"{validation}/dambreak_front/koshizuka_oka_1996_{name}.csv", delimiter=',',
+                                    skiprows=1)
     for T in [0.4, 0.8, 1.2, 1.6, 2.0, 2.4, 2.8]:
         if T <= ts[-1]:
-            line = f"T {T:.1f}: front Z/L {np.interp(T, ts, zs):.3f}"
-            if validation:
-                for name in ['experiment', 'mps']:
-                    ref = np.loadtxt(f"{validation}/dambreak_front/koshizuka_oka_1996_{name}.csv", delimiter=',',
-                                     skiprows=1)
-                    z = np.interp(T, ref[:, 0], ref[:, 1])
-                    line += f"; {name} {z:.3f} ({(np.interp(T, ts, zs) / z - 1) * 100:+.1f} %)"
+            front = np.interp(T, ts, zs)
+            line = f"T {T:.1f}: front Z/L {front:.3f}"
+            for name, ref in refs.items():
+                z = np.interp(T, ref[:, 0], ref[:, 1])
+                line += f"; {name} {z:.3f} ({(front / z - 1) * 100:+.1f} %)"
             print(line)
 
 
