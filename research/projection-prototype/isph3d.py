@@ -32,7 +32,7 @@ import scipy.sparse.linalg as spla
 from scipy.interpolate import RegularGridInterpolator
 from scipy.spatial import cKDTree
 
-from isph import G, L_TANK, RHO, faltinsen_sway_force, first_mode, fit_decay, fit_forced
+from isph import G, L_TANK, RHO, Sim, blew_up, faltinsen_sway_force, first_mode, fit_decay, fit_forced
 
 BREADTH = 0.25
 
@@ -71,14 +71,8 @@ class Sim3:
         s.alpha = 21.0 / (16.0 * np.pi * s.h ** 3)
         s.cint = s.V * s.w(np.sqrt(KX ** 2 + KY ** 2 + KZ ** 2)).sum()
 
-    # Wendland C2 kernel (3D)
-    def dwdr(s, r):
-        q = r / s.h
-        return s.alpha / s.h * (-5.0 * q) * np.clip(1.0 - 0.5 * q, 0, None) ** 3
-
-    def w(s, r):
-        q = r / s.h
-        return s.alpha * np.clip(1.0 - 0.5 * q, 0, None) ** 4 * (2 * q + 1)
+    # the Wendland C2 kernel's shape (its 3D factor is alpha) and the forcing's time history are the 2D script's
+    dwdr, w, motion = Sim.dwdr, Sim.w, Sim.motion
 
     def wall_images(s):
         """Images across the walls x = 0, L, y = 0, B and the floor z = 0: every combination of the walls a
@@ -209,11 +203,6 @@ class Sim3:
         dv = np.einsum('pi,pi->p', vall[s.b] - vall[s.a], s.cgw) * s.V
         return np.bincount(s.a, dv, minlength=s.n)
 
-    def motion(s, t):
-        """The forcing's time history per unit amplitude: sin wt under a half-cosine ramp."""
-        r = 1.0 if t >= s.ramp else 0.5 * (1.0 - np.cos(np.pi * t / s.ramp))
-        return r * np.sin(s.forcing_w * t)
-
     def tank_acc(s, t):
         if s.sway_a == 0.0:
             return 0.0
@@ -322,11 +311,6 @@ class Sim3:
         s.v[:, 0] = -c * k * np.sin(k * xi) * np.cosh(k * z)
         s.v[:, 2] = c * k * np.cos(k * xi) * np.sinh(k * z)
         return 2 * np.pi / w
-
-
-def blew_up(s):
-    speed = np.linalg.norm(s.v, axis=1)
-    return not np.isfinite(speed).all() or speed.max() > 0.5
 
 
 def main():
