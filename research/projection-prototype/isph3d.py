@@ -268,8 +268,8 @@ class Sim3:
         if s.solve == 'direct':
             dpres = spla.spsolve(A.tocsc(), rhs)
         else:
-            # BiCGSTAB with a Jacobi preconditioner from zero, as a particle code would iterate (two
-            # products with the matrix an iteration)
+            # BiCGSTAB with a Jacobi preconditioner, from zero or the last increment, as a particle code would
+            # iterate (two products with the matrix an iteration)
             count = [0]
 
             def tick(_):
