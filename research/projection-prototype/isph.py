@@ -6,7 +6,9 @@ incompressible scheme ("The projection prototype's surface shift" and the sectio
 The algorithm, one step:
   1. images: mirror images across the tank's walls, and across the free surface (pressure reversed there,
      so p = 0 on it; velocity continued evenly). The surface is a height function eta(x) (`--surface
-     height`) or, at each point, the tangent plane averaged from the nearby surface particles (`plane`);
+     height`) or, at each point, the tangent plane averaged from the nearby surface particles (`plane`); a
+     wall image's height function is its parent's, or with `--continued-surface` moved by the body force's
+     slope across the wall, to where the image's continued pressure is zero;
   2. predictor: v* = v + dt (f - G p / rho + nu L v), f the body force in the tank frame, G the corrected
      difference gradient;
   3. pressure increment: L dp = rho/dt D v* + gamma (D G - L) p - beta rho (C - C0) / (C0 dt^2),
@@ -23,6 +25,7 @@ The algorithm, one step:
 Usage (numpy and scipy):
   python3 isph.py decay --layers 24 [--dp 0.008] [--jitter 0.1] [--cycles 5]
   python3 isph.py rest --layers 24 --jitter 0.1 [--tend 3]
+  python3 isph.py rest --layers 24 --tilt 5 --tend 8 [--ramp 5] [--continued-surface]
   python3 isph.py sway --layers 24 --ratio 0.8 [--amp 0.004]
   python3 isph.py pitch --layers 24 --ratio 0.8 [--amp 0.0087]
   python3 isph.py dambreak --surface plane --wall-clearance 0.5 [--validation DIR]
@@ -44,12 +47,18 @@ class Sim:
     def __init__(s, layers, dp, length=L_TANK, dt=0.002, hfac=1.3, nu=1e-6, gamma=0.05, shift_a=2.0, shift_b=0.05,
                  surface_sigma=1.5, beta=0.003, jitter=0.0, seed=1, sway_a=0.0, pitch_a=0.0, forcing_w=0.0, ramp=0.0,
                  surface='height', wall_clearance=0.05, pressure='increment', memory=0.95, memory_depth=0.0,
-                 memory_top=0.0, memory_clip=0.0, blend=(0.0, 0.0), ballistic_splash=False, collide=0.0):
+                 memory_top=0.0, memory_clip=0.0, blend=(0.0, 0.0), ballistic_splash=False, collide=0.0,
+                 tilt=0.0, tilt_ramp=0.0, continued_surface=False):
         s.L, s.dp, s.h, s.dt = length, dp, hfac * dp, dt
         s.rc = 2.0 * s.h
         s.nu, s.gamma, s.A, s.B, s.sigma, s.beta = nu, gamma, shift_a, shift_b, surface_sigma, beta
         assert sway_a == 0.0 or pitch_a == 0.0, "sway or pitch, not both"
         s.sway_a, s.pitch_a, s.forcing_w, s.ramp = sway_a, pitch_a, forcing_w, ramp
+        # a held pitch, reached from level under a half-cosine ramp of tilt_ramp seconds
+        s.tilt, s.tilt_ramp = tilt, tilt_ramp
+        # the free surface seen by a wall image: the height function continued evenly across the wall (as the
+        # liquid's images are), or where the image's pressure, continued with the body force, is zero
+        s.continued_surface = continued_surface
         s.detmin, s.wc = 0.25, wall_clearance
         s.surface = surface
         # pressure 'total': solve for the whole pressure, carrying `memory` of the old pressure's mismatch
@@ -142,6 +151,12 @@ class Sim:
     def height_images(s, allx):
         """Images across the height function: every point within 2h below eta(x)."""
         eta = s.height(allx[:, 0])
+        if s.continued_surface:
+            # a wall image's pressure is its parent's plus rho f . (image - parent) (image_p): its surface is
+            # where that is zero, the parent's surface moved by the body force's slope along the wall normal
+            par = s.par[s.n:s.nw]
+            f = s.flipx[s.n:s.nw]
+            eta[s.n:][f] += s.body[par[f], 0] / -s.body[par[f], 1] * (allx[s.n:][f, 0] - s.x[par[f], 0])
         s.depth_below = eta[:s.n] - s.x[:, 1]
         cand = np.nonzero(allx[:, 1] > eta - s.rc)[0]
         return cand, np.stack([allx[cand, 0], 2 * eta[cand] - allx[cand, 1]], 1)
@@ -279,10 +294,12 @@ class Sim:
     def body_force(s, t):
         """Force per unit mass on each particle in the tank frame: gravity, the sway's inertial force, and
         the pitch's (theta about +y through the centre of the floor; positive theta turns the apparent
-        gravity towards +x): Euler -theta'' y x r, Coriolis -2 theta' y x v, centrifugal theta'^2 r."""
+        gravity towards +x): Euler -theta'' y x r, Coriolis -2 theta' y x v, centrifugal theta'^2 r. A held
+        tilt is added to theta; its ramp is slow enough to leave out its rates."""
         f = np.empty((s.n, 2))
         rate, accel = s.motion_rates(t)
-        th, thd, thdd = s.pitch_a * s.motion(t), s.pitch_a * rate, s.pitch_a * accel
+        share = 1.0 if t >= s.tilt_ramp else 0.5 * (1.0 - np.cos(np.pi * t / s.tilt_ramp))
+        th, thd, thdd = s.tilt * share + s.pitch_a * s.motion(t), s.pitch_a * rate, s.pitch_a * accel
         xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, 1]
         f[:, 0] = G * np.sin(th) - s.sway_a * accel - thdd * z - 2 * thd * s.v[:, 1] + thd ** 2 * xr
         f[:, 1] = -G * np.cos(th) + thdd * xr + 2 * thd * s.v[:, 0] + thd ** 2 * z
@@ -480,7 +497,7 @@ def pitch_moment(w, depth, modes=400):
         bc = 8.0 / (L * k ** 3)
         bs = bc * np.tanh(k * c)
         a = (w2 * (h * e + bs) + g * e) / (wn2 - w2)
-        sech = 1.0 / np.cosh(k * h)
+        sech = 1.0 / np.cosh(k * h) if k * h < 700.0 else 0.0  # (cosh overflows past 710)
         inertia += -4.0 * bc * (c / k - np.tanh(k * c) / (k * k)) + 4.0 * bs / (k * k)
         inertia += -2.0 * a * (h * np.tanh(k * h) / k - (1.0 - sech) / (k * k)) + 2.0 * a * (1.0 - sech) / (k * k)
         surface += -2.0 * a * np.tanh(k * h) / k
@@ -497,6 +514,63 @@ def fit_forced(t, f, w, w1):
 
     q = least_squares(res, [0, 0, 0, 0, 0.01, w1]).x
     return np.hypot(q[0], q[1]), np.degrees(np.arctan2(q[0], q[1]))
+
+
+def level_summary(s, held, T1):
+    """The tilted tank at rest, averaged over the last first-mode period (rows of held: centroid x from the
+    floor's centre, centroid z, rms and largest departure of the surface from the level plane): the weight's
+    moment about y through the centre of the floor against that of the level liquid in the tilted box."""
+    th, slope, h0, L = s.tilt, np.tan(s.tilt), s.depth, s.L
+    xc, zc = slope * L ** 2 / (12 * h0), h0 / 2 + slope ** 2 * L ** 2 / (24 * h0)
+    xm, zm = held[:, 0].mean(), held[:, 1].mean()
+    moment, m_th = zm * np.sin(th) + xm * np.cos(th), zc * np.sin(th) + xc * np.cos(th)
+    return (f"tank tilted {np.degrees(th):g} deg at rest, {s.n} particles (last {T1:.2f} s): surface from the "
+            f"level plane rms {held[:, 2].mean() / s.dp:.3f} dp, largest {held[:, 3].max() / s.dp:.3f} dp; "
+            f"centroid x {xm * 1000:.2f} mm (theory {xc * 1000:.2f}), z {zm * 1000:.2f} mm "
+            f"(theory {zc * 1000:.2f}); the weight's moment about the floor's centre "
+            f"{(moment / m_th - 1) * 100:+.2f} % from theory")
+
+
+def forced_response(s, pitch, ratio, depth, breadth=1.0):
+    """Runs a forced sway or pitch (the simulation set up with its amplitude, frequency and ramp of two
+    forcing periods) to five forcing periods or six natural ones after the ramp, whichever is longer, and
+    says how the liquid's force or moment on the tank, fitted at the forcing frequency, compares with linear
+    theory (per unit breadth, times `breadth` in 3D)."""
+    amp, w = (s.pitch_a if pitch else s.sway_a), s.forcing_w
+    w1 = first_mode(depth)
+    zi = s.x.shape[1] - 1
+    mass = RHO * s.V * s.n
+    s.neighbours()
+    ts, P, Ly, tb, Mb = [], [], [], [], []
+    while s.t < s.ramp + max(5 * 2 * np.pi / w, 6 * 2 * np.pi / w1):
+        xb, zb = s.x[:, 0] - 0.5 * s.L, s.x[:, zi].copy()
+        s.step()
+        if blew_up(s):
+            return f"blew up at {s.t:.3f} s"
+        # moments about the centre of the floor, y component of r x (.)
+        tb.append(s.t - 0.5 * s.dt)
+        Mb.append(RHO * s.V * np.sum(zb * s.body[:, 0] - xb * s.body[:, zi]))
+        xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, zi]
+        ts.append(s.t)
+        P.append(RHO * s.V * s.v[:, 0].sum())
+        Ly.append(RHO * s.V * np.sum(z * s.v[:, 0] - xr * s.v[:, zi]))
+    ts, P, Ly = np.array(ts), np.array(P), np.array(Ly)
+    if pitch:
+        # the liquid's moment on the tank: its body forces' moment less the rate of its angular momentum
+        resp = np.interp(ts, tb, Mb) - np.gradient(Ly, ts)
+        th = pitch_moment(w, depth) * breadth * amp
+        what, unit = "moment per rotation", "N m/rad"
+    else:
+        # (Faltinsen's solution per unit breadth with the liquid's whole mass is the solution times the breadth)
+        resp = -(np.gradient(P, ts) + mass * np.array([s.tank_acc(t) for t in ts]))
+        th = faltinsen_sway_force(w, depth, mass, amp)
+        what, unit = "force per displacement", "N/m"
+    m = ts > s.ramp
+    got, phase = fit_forced(ts[m], resp[m], w, w1)
+    dph = (phase - (0.0 if th > 0 else 180.0) + 180) % 360 - 180
+    return (f"{'pitch' if pitch else 'sway'} at {ratio} of the first mode, {s.n} particles: {what} "
+            f"{got / amp:.1f} {unit}, theory {abs(th) / amp:.1f} {unit} ({(got / abs(th) - 1) * 100:+.1f} %), "
+            f"phase {dph:+.1f} deg")
 
 
 def blew_up(s):
@@ -575,6 +649,15 @@ def main():
     ap.add_argument('--jitter', type=float, default=0.0)
     ap.add_argument('--cycles', type=float, default=5.0)
     ap.add_argument('--tend', type=float, default=3.0)
+    ap.add_argument('--gamma', type=float, default=0.05,
+                    help='increment: the pressure stabilisation\'s share of (D G - L) p')
+    ap.add_argument('--shift-a', type=float, default=2.0, help='shifting: the velocity-scaled coefficient A')
+    ap.add_argument('--shift-b', type=float, default=0.05, help='shifting: the fixed coefficient B')
+    ap.add_argument('--tilt', type=float, default=0.0, help='rest: the tank\'s held pitch, degrees')
+    ap.add_argument('--ramp', type=float, default=5.0, help='rest: seconds to reach the tilt from level')
+    ap.add_argument('--continued-surface', action='store_true',
+                    help='height surface: a wall image\'s free surface is where its continued pressure is zero '
+                         '(not the even continuation of the height function)')
     ap.add_argument('--ratio', type=float, default=0.8)
     ap.add_argument('--amp', type=float, default=None)
     ap.add_argument('--surface', choices=['height', 'plane'], default='height',
@@ -601,7 +684,8 @@ def main():
     a = ap.parse_args()
     kw = dict(surface=a.surface, wall_clearance=a.wall_clearance, pressure=a.pressure, memory=a.memory,
               memory_depth=a.memory_depth, memory_top=a.memory_top, memory_clip=a.memory_clip,
-              blend=tuple(a.conservative_blend), ballistic_splash=a.ballistic_splash, collide=a.collide)
+              blend=tuple(a.conservative_blend), ballistic_splash=a.ballistic_splash, collide=a.collide,
+              continued_surface=a.continued_surface, gamma=a.gamma, shift_a=a.shift_a, shift_b=a.shift_b)
     if a.case == 'dambreak':
         dam_break(a.column, a.tend, kw, a.validation)
         return
@@ -624,8 +708,11 @@ def main():
             print(f"free decay: theory T {T:.4f} s; measured {per:.4f} s ({(per / T - 1) * 100:+.2f} %), "
                   f"damping ratio {z:.5f}")
     elif a.case == 'rest':
-        s = Sim(a.layers, a.dp, jitter=a.jitter, **kw)
+        s = Sim(a.layers, a.dp, jitter=a.jitter, tilt=np.radians(a.tilt), tilt_ramp=a.ramp, **kw)
         s.neighbours()
+        T1 = 2 * np.pi / first_mode(s.depth)
+        cols = (np.arange(1, round(s.L / s.dp) - 1) + 0.5) * s.dp
+        held = []
         for i in range(1, int(round(a.tend / s.dt)) + 1):
             s.step()
             if blew_up(s):
@@ -634,46 +721,21 @@ def main():
             if i % 50 == 0:
                 speed = np.linalg.norm(s.v, axis=1)
                 print(f"t {s.t:.2f} s: mean speed {speed.mean():.2e} m/s, max {speed.max():.2e} m/s")
+            if a.tilt != 0 and s.t > a.tend - T1:
+                # the surface, more than a spacing from the walls, against the level plane of the tilted tank
+                dev = s.height(cols) - (s.depth + np.tan(s.tilt) * (cols - 0.5 * s.L))
+                held.append((s.x[:, 0].mean() - 0.5 * s.L, s.x[:, 1].mean(), np.sqrt(np.mean(dev ** 2)),
+                             np.abs(dev).max()))
+        if held:
+            print(level_summary(s, np.array(held), T1))
     else:
         pitch = a.case == 'pitch'
         amp = (np.radians(0.5) if pitch else 0.004) if a.amp is None else a.amp
         w1 = first_mode(a.layers * a.dp)
         w = a.ratio * w1
-        Tf, T1 = 2 * np.pi / w, 2 * np.pi / w1
-        ramp = 2 * Tf
         motion = dict(pitch_a=amp) if pitch else dict(sway_a=amp)
-        s = Sim(a.layers, a.dp, jitter=a.jitter, forcing_w=w, ramp=ramp, **motion, **kw)
-        s.neighbours()
-        mass = RHO * s.V * s.n
-        ts, P, Ly, tb, Mb = [], [], [], [], []
-        while s.t < ramp + max(5 * Tf, 6 * T1):
-            xb, zb = s.x[:, 0] - 0.5 * s.L, s.x[:, 1].copy()
-            s.step()
-            if blew_up(s):
-                print(f"blew up at {s.t:.3f} s")
-                return
-            # moments about the centre of the floor, y component of r x (.)
-            tb.append(s.t - 0.5 * s.dt)
-            Mb.append(RHO * s.V * np.sum(zb * s.body[:, 0] - xb * s.body[:, 1]))
-            xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, 1]
-            ts.append(s.t)
-            P.append(RHO * s.V * s.v[:, 0].sum())
-            Ly.append(RHO * s.V * np.sum(z * s.v[:, 0] - xr * s.v[:, 1]))
-        ts, P, Ly = np.array(ts), np.array(P), np.array(Ly)
-        if pitch:
-            # the liquid's moment on the tank: its body forces' moment less the rate of its angular momentum
-            resp = np.interp(ts, tb, Mb) - np.gradient(Ly, ts)
-            th = pitch_moment(w, a.layers * a.dp) * amp
-            what, unit = "moment per rotation", "N m/rad"
-        else:
-            resp = -(np.gradient(P, ts) + mass * np.array([s.tank_acc(t) for t in ts]))
-            th = faltinsen_sway_force(w, a.layers * a.dp, mass, amp)
-            what, unit = "force per displacement", "N/m"
-        m = ts > ramp
-        got, phase = fit_forced(ts[m], resp[m], w, w1)
-        dph = (phase - (0.0 if th > 0 else 180.0) + 180) % 360 - 180
-        print(f"{a.case} at {a.ratio} of the first mode: {what} {got / amp:.1f} {unit}, theory "
-              f"{abs(th) / amp:.1f} {unit} ({(got / abs(th) - 1) * 100:+.1f} %), phase {dph:+.1f} deg")
+        s = Sim(a.layers, a.dp, jitter=a.jitter, forcing_w=w, ramp=2 * 2 * np.pi / w, **motion, **kw)
+        print(forced_response(s, pitch, a.ratio, a.layers * a.dp))
 
 
 if __name__ == '__main__':

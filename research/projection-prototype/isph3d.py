@@ -1,14 +1,16 @@
 """3D projection SPH (ISPH) prototype: the 2D prototype's first configuration (`isph.py` with its defaults:
 the free surface as a mirror across a height function, the pressure-increment scheme) in the 3D seed tank,
-for the free decay and forced sway of its first mode along the tank. Not part of the product: it measures
-whether the configuration that meets the free-decay and forced-response bounds in 2D meets them in 3D at the
-spacings two cores can run in real time. The manual's decisions page for the incompressible scheme
-("The projection prototype in 3D") gives what it measures.
+for the free decay, the forced sway and pitch of its first mode along the tank, and the tilted tank at rest.
+Not part of the product: it measures whether the configuration that meets the free-decay and forced-response
+bounds in 2D meets them in 3D at the spacings two cores can run in real time. The manual's decisions page for
+the incompressible scheme ("The projection prototype in 3D", "The tilted tank at rest") gives what it
+measures.
 
 The step is `isph.py`'s, with the images in 3D:
   1. images: mirror images across the tank's five walls (a particle near an edge or a corner also has the
      images across two or three walls), and across the free surface z = eta(x, y) (pressure reversed there,
-     velocity continued evenly);
+     velocity continued evenly; with --continued-surface a wall image's eta is moved by the body force's
+     slope across the wall, as in 2D);
   2. predictor: v* = v + dt (f - G p / rho + nu L v), G the corrected difference gradient;
   3. pressure increment: L dp = rho/dt D v* + gamma (D G - L) p - beta rho (C - C0) / (C0 dt^2), solved
      by BiCGSTAB with a Jacobi preconditioner from zero (or the last increment, --warm-start) to a relative
@@ -32,23 +34,30 @@ import scipy.sparse.linalg as spla
 from scipy.interpolate import RegularGridInterpolator
 from scipy.spatial import cKDTree
 
-from isph import G, L_TANK, RHO, Sim, blew_up, faltinsen_sway_force, first_mode, fit_decay, fit_forced
+from isph import G, L_TANK, RHO, Sim, blew_up, first_mode, fit_decay, forced_response, level_summary
 
 BREADTH = 0.25
 
 
 class Sim3:
     def __init__(s, layers, dp, dt=0.004, hfac=1.3, nu=1e-6, gamma=0.05, shift_a=2.0, shift_b=0.05,
-                 surface_sigma=1.5, beta=0.003, jitter=0.0, seed=1, sway_a=0.0, forcing_w=0.0, ramp=0.0,
-                 wall_clearance=0.05, solve='bicgstab', rtol=1e-8, warm_start=False):
+                 surface_sigma=1.5, beta=0.003, jitter=0.0, seed=1, sway_a=0.0, pitch_a=0.0, tilt=0.0,
+                 tilt_ramp=0.0, forcing_w=0.0, ramp=0.0, wall_clearance=0.05, solve='bicgstab', rtol=1e-8,
+                 warm_start=False, continued_surface=False):
         s.solve, s.rtol, s.iterations, s.warm_start, s.last_dp = solve, rtol, [], warm_start, None
         s.L, s.dp, s.h, s.dt = L_TANK, dp, hfac * dp, dt
         s.nx, s.ny = int(round(s.L / dp)), int(round(BREADTH / dp))
         s.B = s.ny * dp
         s.rc = 2.0 * s.h
         s.nu, s.gamma, s.A, s.Bs, s.sigma, s.beta = nu, gamma, shift_a, shift_b, surface_sigma, beta
-        s.sway_a, s.forcing_w, s.ramp = sway_a, forcing_w, ramp
+        assert sway_a == 0.0 or pitch_a == 0.0, "sway or pitch, not both"
+        s.sway_a, s.pitch_a, s.forcing_w, s.ramp = sway_a, pitch_a, forcing_w, ramp
+        # a held pitch, reached from level under a half-cosine ramp of tilt_ramp seconds
+        s.tilt, s.tilt_ramp = tilt, tilt_ramp
         s.detmin, s.wc = 0.25, wall_clearance
+        # the free surface seen by a wall image: the height function continued evenly across the wall (as the
+        # liquid's images are), or where the image's pressure, continued with the body force, is zero
+        s.continued_surface = continued_surface
         k = np.arange(-4, 5) * dp
         KX, KY, KZ = np.meshgrid(k, k, k)
         X, Y, Z = np.meshgrid((np.arange(s.nx) + 0.5) * dp, (np.arange(s.ny) + 0.5) * dp,
@@ -71,8 +80,9 @@ class Sim3:
         s.alpha = 21.0 / (16.0 * np.pi * s.h ** 3)
         s.cint = s.V * s.w(np.sqrt(KX ** 2 + KY ** 2 + KZ ** 2)).sum()
 
-    # the Wendland C2 kernel's shape (its 3D factor is alpha) and the forcing's time history are the 2D script's
-    dwdr, w, motion = Sim.dwdr, Sim.w, Sim.motion
+    # the Wendland C2 kernel's shape (its 3D factor is alpha), the forcing's time history and its rates, and
+    # the sway's acceleration are the 2D script's
+    dwdr, w, motion, motion_rates, tank_acc = Sim.dwdr, Sim.w, Sim.motion, Sim.motion_rates, Sim.tank_acc
 
     def wall_images(s):
         """Images across the walls x = 0, L, y = 0, B and the floor z = 0: every combination of the walls a
@@ -141,6 +151,14 @@ class Sim3:
         s.nw = len(allx)
         # images across the surface: every point within 2h below eta
         eta = s.height(allx)
+        if s.continued_surface:
+            # a wall image's pressure is its parent's plus rho f . (image - parent) (image_p): its surface is
+            # where that is zero, the parent's surface moved by the body force's slope along the wall normal
+            par = s.par[s.n:]
+            for d in (0, 1):
+                f = s.flip[s.n:, d]
+                slope = s.body[par[f], d] / -s.body[par[f], 2]
+                eta[s.n:][f] += slope * (allx[s.n:][f, d] - s.x[par[f], d])
         s.depth_below = eta[:s.n] - s.x[:, 2]
         cand = np.nonzero(allx[:, 2] > eta - s.rc)[0]
         img = allx[cand].copy()
@@ -203,11 +221,20 @@ class Sim3:
         dv = np.einsum('pi,pi->p', vall[s.b] - vall[s.a], s.cgw) * s.V
         return np.bincount(s.a, dv, minlength=s.n)
 
-    def tank_acc(s, t):
-        if s.sway_a == 0.0:
-            return 0.0
-        e = 1e-4
-        return s.sway_a * (s.motion(t + e) - 2 * s.motion(t) + s.motion(t - e)) / e ** 2
+    def body_force(s, t):
+        """Force per unit mass on each particle in the tank frame: gravity, the sway's inertial force, and the
+        pitch's (theta about +y through the centre of the floor, the held tilt added, whose ramp is slow enough
+        to leave out its rates; positive theta turns the apparent gravity towards +x), as in the 2D script."""
+        if s.pitch_a == 0.0 and s.tilt == 0.0:
+            return np.tile([-s.tank_acc(t), 0.0, -G], (s.n, 1))
+        m, rate, accel = (s.motion(t), *s.motion_rates(t)) if s.pitch_a != 0.0 else (0.0, 0.0, 0.0)
+        share = 1.0 if t >= s.tilt_ramp else 0.5 * (1.0 - np.cos(np.pi * t / s.tilt_ramp))
+        th, thd, thdd = s.tilt * share + s.pitch_a * m, s.pitch_a * rate, s.pitch_a * accel
+        xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, 2]
+        f = np.zeros((s.n, 3))
+        f[:, 0] = G * np.sin(th) - s.tank_acc(t) - thdd * z - 2 * thd * s.v[:, 2] + thd ** 2 * xr
+        f[:, 2] = -G * np.cos(th) + thdd * xr + 2 * thd * s.v[:, 0] + thd ** 2 * z
+        return f
 
     def surface_shift(s, sh):
         """Subtract from the top layer's shift its Gaussian-weighted mean along the layer (images across the
@@ -232,7 +259,7 @@ class Sim3:
 
     def step(s):
         dt, n = s.dt, s.n
-        body = s.body = np.tile([-s.tank_acc(s.t + 0.5 * dt), 0.0, -G], (n, 1))
+        body = s.body = s.body_force(s.t + 0.5 * dt)
         s.neighbours()
         a, b = s.a, s.b
         # splash: a particle with too few neighbours, images included, keeps p = 0
@@ -303,6 +330,14 @@ class Sim3:
             s.x[:, d] = np.clip(s.x[:, d], lo, hi)
         s.t += dt
 
+    def level_error(s):
+        """The height function's departure from the level surface of the tilted tank, over the columns more
+        than a spacing from the walls."""
+        g = np.arange(1.5, s.nx - 1) * s.dp
+        gx, gy = np.meshgrid(g, np.arange(1.5, s.ny - 1) * s.dp, indexing='ij')
+        q = np.stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)], 1)
+        return s.height(q) - (s.depth + np.tan(s.tilt) * (q[:, 0] - 0.5 * s.L))
+
     def start_first_mode(s, amp):
         k = np.pi / s.L
         w = np.sqrt(G * k * np.tanh(k * s.depth))
@@ -315,7 +350,7 @@ class Sim3:
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument('case', choices=['decay', 'sway'])
+    ap.add_argument('case', choices=['decay', 'rest', 'sway', 'pitch'])
     ap.add_argument('--layers', type=int, default=20)
     ap.add_argument('--dp', type=float, default=0.02)
     ap.add_argument('--dt', type=float, default=0.004)
@@ -323,6 +358,14 @@ def main():
     ap.add_argument('--cycles', type=float, default=5.0)
     ap.add_argument('--ratio', type=float, default=0.8)
     ap.add_argument('--amp', type=float, default=None)
+    ap.add_argument('--tilt', type=float, default=5.0, help='rest: the tank\'s pitch, degrees')
+    ap.add_argument('--ramp', type=float, default=5.0, help='rest: seconds to reach the tilt from level')
+    ap.add_argument('--tend', type=float, default=8.0, help='rest: how long to run, seconds')
+    ap.add_argument('--wall-clearance', type=float, default=0.05,
+                    help='closest approach of a particle to a wall, in dp')
+    ap.add_argument('--continued-surface', action='store_true',
+                    help='a wall image\'s free surface is where its continued pressure is zero (not the even '
+                         'continuation of the height function)')
     ap.add_argument('--gamma', type=float, default=0.05,
                     help='the pressure stabilisation\'s share of (D G - L) p (one less the memory)')
     ap.add_argument('--solve', choices=['direct', 'bicgstab'], default='bicgstab',
@@ -330,7 +373,8 @@ def main():
     ap.add_argument('--rtol', type=float, default=1e-8, help='bicgstab: relative residual to stop at')
     ap.add_argument('--warm-start', action='store_true', help='bicgstab: start from the last step\'s increment')
     a = ap.parse_args()
-    solve = dict(solve=a.solve, rtol=a.rtol, warm_start=a.warm_start, gamma=a.gamma)
+    solve = dict(solve=a.solve, rtol=a.rtol, warm_start=a.warm_start, gamma=a.gamma,
+                 continued_surface=a.continued_surface, wall_clearance=a.wall_clearance)
     start = time.time()
     if a.case == 'decay':
         s = Sim3(a.layers, a.dp, dt=a.dt, jitter=a.jitter, **solve)
@@ -350,33 +394,30 @@ def main():
             per, z = fit_decay(ts[ts >= T], ys[ts >= T], T)
             print(f"3D free decay, {s.n} particles ({s.nx} x {s.ny} x {a.layers}): theory T {T:.4f} s; measured "
                   f"{per:.4f} s ({(per / T - 1) * 100:+.2f} %), damping ratio {z:.5f}")
-    else:
-        amp = 0.004 if a.amp is None else a.amp
-        w1 = first_mode(a.layers * a.dp)
-        w = a.ratio * w1
-        Tf, T1 = 2 * np.pi / w, 2 * np.pi / w1
-        ramp = 2 * Tf
-        s = Sim3(a.layers, a.dp, dt=a.dt, jitter=a.jitter, sway_a=amp, forcing_w=w, ramp=ramp, **solve)
+    elif a.case == 'rest':
+        s = Sim3(a.layers, a.dp, dt=a.dt, jitter=a.jitter, tilt=np.radians(a.tilt), tilt_ramp=a.ramp, **solve)
         s.neighbours()
-        mass = RHO * s.V * s.n
-        ts, P = [], []
-        while s.t < ramp + max(5 * Tf, 6 * T1):
+        T1 = 2 * np.pi / first_mode(s.depth)
+        held = []
+        while s.t < a.tend - 1e-9:
             s.step()
             if blew_up(s):
                 print(f"blew up at {s.t:.3f} s")
                 return
-            ts.append(s.t)
-            P.append(RHO * s.V * s.v[:, 0].sum())
-        ts, P = np.array(ts), np.array(P)
-        resp = -(np.gradient(P, ts) + mass * np.array([s.tank_acc(t) for t in ts]))
-        # Faltinsen's force per unit breadth (the 2D solution's mass is the 2D section's) times the breadth
-        th = faltinsen_sway_force(w, a.layers * a.dp, mass, amp)
-        m = ts > ramp
-        got, phase = fit_forced(ts[m], resp[m], w, w1)
-        dph = (phase - (0.0 if th > 0 else 180.0) + 180) % 360 - 180
-        print(f"3D sway at {a.ratio} of the first mode, {s.n} particles: force per displacement "
-              f"{got / amp:.1f} N/m, theory {abs(th) / amp:.1f} N/m ({(got / abs(th) - 1) * 100:+.1f} %), "
-              f"phase {dph:+.1f} deg")
+            if s.t > a.tend - T1:
+                dev = s.level_error()
+                held.append((s.x[:, 0].mean() - 0.5 * s.L, s.x[:, 2].mean(), np.sqrt(np.mean(dev ** 2)),
+                             np.abs(dev).max()))
+        speed = np.linalg.norm(s.v, axis=1)
+        print(f"3D {level_summary(s, np.array(held), T1)}; speed mean {speed.mean():.1e} m/s, largest "
+              f"{speed.max():.1e} m/s")
+    else:
+        pitch = a.case == 'pitch'
+        amp = (np.radians(0.5) if pitch else 0.004) if a.amp is None else a.amp
+        w = a.ratio * first_mode(a.layers * a.dp)
+        motion = dict(pitch_a=amp) if pitch else dict(sway_a=amp)
+        s = Sim3(a.layers, a.dp, dt=a.dt, jitter=a.jitter, forcing_w=w, ramp=2 * 2 * np.pi / w, **motion, **solve)
+        print(f"3D {forced_response(s, pitch, a.ratio, a.layers * a.dp, s.B)}")
     if s.iterations:
         it = np.array(s.iterations)
         print(f"BiCGSTAB to {a.rtol:g}: {it.mean():.1f} iterations a step (median {np.median(it):.0f}, "
