@@ -292,17 +292,9 @@ class Sim:
         return s.sway_a * s.motion_rates(t)[1] if s.sway_a > 0 else 0.0
 
     def body_force(s, t):
-        """Force per unit mass on each particle in the tank frame: gravity, the sway's inertial force, and
-        the pitch's (theta about +y through the centre of the floor; positive theta turns the apparent
-        gravity towards +x): Euler -theta'' y x r, Coriolis -2 theta' y x v, centrifugal theta'^2 r. A held
-        tilt is added to theta; its ramp is slow enough to leave out its rates."""
+        """Force per unit mass on each particle in the tank frame (`frame_force`)."""
         f = np.empty((s.n, 2))
-        rate, accel = s.motion_rates(t)
-        share = 1.0 if t >= s.tilt_ramp else 0.5 * (1.0 - np.cos(np.pi * t / s.tilt_ramp))
-        th, thd, thdd = s.tilt * share + s.pitch_a * s.motion(t), s.pitch_a * rate, s.pitch_a * accel
-        xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, 1]
-        f[:, 0] = G * np.sin(th) - s.sway_a * accel - thdd * z - 2 * thd * s.v[:, 1] + thd ** 2 * xr
-        f[:, 1] = -G * np.cos(th) + thdd * xr + 2 * thd * s.v[:, 0] + thd ** 2 * z
+        f[:, 0], f[:, 1] = frame_force(s, t, s.x[:, 1], s.v[:, 0], s.v[:, 1])
         return f
 
     def surface_shift(s, sh):
@@ -443,6 +435,21 @@ class Sim:
         s.v[:, 0] = -c * k * np.sin(k * xi) * np.cosh(k * z)
         s.v[:, 1] = c * k * np.cos(k * xi) * np.sinh(k * z)
         return 2 * np.pi / w
+
+
+def frame_force(s, t, z, vx, vz):
+    """The x and z components of the force per unit mass in the tank frame, for particles at height z (and
+    x = s.x[:, 0]) moving at (vx, vz): gravity, the sway's inertial force, and the pitch's (theta about +y
+    through the centre of the floor; positive theta turns the apparent gravity towards +x): Euler
+    -theta'' y x r, Coriolis -2 theta' y x v, centrifugal theta'^2 r. A held tilt is added to theta; its ramp
+    is slow enough to leave out its rates."""
+    m, rate, accel = (s.motion(t), *s.motion_rates(t)) if s.pitch_a != 0.0 else (0.0, 0.0, 0.0)
+    share = 1.0 if t >= s.tilt_ramp else 0.5 * (1.0 - np.cos(np.pi * t / s.tilt_ramp))
+    th, thd, thdd = s.tilt * share + s.pitch_a * m, s.pitch_a * rate, s.pitch_a * accel
+    xr = s.x[:, 0] - 0.5 * s.L
+    fx = G * np.sin(th) - s.tank_acc(t) - thdd * z - 2 * thd * vz + thd ** 2 * xr
+    fz = -G * np.cos(th) + thdd * xr + 2 * thd * vx + thd ** 2 * z
+    return fx, fz
 
 
 def first_mode(depth):

@@ -34,7 +34,8 @@ import scipy.sparse.linalg as spla
 from scipy.interpolate import RegularGridInterpolator
 from scipy.spatial import cKDTree
 
-from isph import G, L_TANK, RHO, Sim, blew_up, first_mode, fit_decay, forced_response, level_summary
+from isph import (G, L_TANK, RHO, Sim, blew_up, first_mode, fit_decay, forced_response, frame_force,
+                  level_summary)
 
 BREADTH = 0.25
 
@@ -222,18 +223,12 @@ class Sim3:
         return np.bincount(s.a, dv, minlength=s.n)
 
     def body_force(s, t):
-        """Force per unit mass on each particle in the tank frame: gravity, the sway's inertial force, and the
-        pitch's (theta about +y through the centre of the floor, the held tilt added, whose ramp is slow enough
-        to leave out its rates; positive theta turns the apparent gravity towards +x), as in the 2D script."""
+        """Force per unit mass on each particle in the tank frame: the 2D script's (`frame_force`), nothing
+        along y."""
         if s.pitch_a == 0.0 and s.tilt == 0.0:
             return np.tile([-s.tank_acc(t), 0.0, -G], (s.n, 1))
-        m, rate, accel = (s.motion(t), *s.motion_rates(t)) if s.pitch_a != 0.0 else (0.0, 0.0, 0.0)
-        share = 1.0 if t >= s.tilt_ramp else 0.5 * (1.0 - np.cos(np.pi * t / s.tilt_ramp))
-        th, thd, thdd = s.tilt * share + s.pitch_a * m, s.pitch_a * rate, s.pitch_a * accel
-        xr, z = s.x[:, 0] - 0.5 * s.L, s.x[:, 2]
         f = np.zeros((s.n, 3))
-        f[:, 0] = G * np.sin(th) - s.tank_acc(t) - thdd * z - 2 * thd * s.v[:, 2] + thd ** 2 * xr
-        f[:, 2] = -G * np.cos(th) + thdd * xr + 2 * thd * s.v[:, 0] + thd ** 2 * z
+        f[:, 0], f[:, 2] = frame_force(s, t, s.x[:, 2], s.v[:, 0], s.v[:, 2])
         return f
 
     def surface_shift(s, sh):
